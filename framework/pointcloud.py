@@ -1,0 +1,82 @@
+"""A sampled manifold: the points, optional markers and what is known about it exactly."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .errors import InputError
+
+
+@dataclass
+class PointCloud:
+    """N points in R^D sampling a d-manifold.
+
+    Attributes
+    ----------
+    points : (N, D) float64, coordinates (length units of the source)
+    markers : (M, D) float64 or None, coarser geometric markers (thesis §3.3)
+    intrinsic_dim : d, if known
+    exact : known exact quantities (``area``, ``euler_characteristic``, ``genus``...)
+    parameters : (N, d) intrinsic coordinates of generated points, if known
+    name : a short label for reports
+    """
+
+    points: np.ndarray
+    markers: np.ndarray | None = None
+    intrinsic_dim: int | None = None
+    exact: dict[str, float] = field(default_factory=dict)
+    parameters: np.ndarray | None = None
+    name: str = "points"
+
+    def __post_init__(self):
+        self.points = validate_points(self.points, what=f"{self.name} points")
+        if self.markers is not None:
+            self.markers = validate_points(self.markers, what=f"{self.name} markers")
+            if self.markers.shape[1] != self.points.shape[1]:
+                raise InputError(
+                    f"markers have dimension {self.markers.shape[1]} but points have "
+                    f"{self.points.shape[1]}; give markers in the same ambient space."
+                )
+
+    @property
+    def n_points(self) -> int:
+        return self.points.shape[0]
+
+    @property
+    def ambient_dim(self) -> int:
+        return self.points.shape[1]
+
+
+def validate_points(X, *, what: str = "points", min_points: int = 1) -> np.ndarray:
+    """Check an (N, D) array of finite, distinct coordinates; return it as float64.
+
+    Raises :class:`InputError` naming the bad rows and the fix.
+    """
+    X = np.asarray(X, dtype=np.float64)
+    if X.ndim != 2:
+        raise InputError(
+            f"{what} must be a 2-D array of shape (n_points, n_dims); got shape {X.shape}."
+        )
+    if X.shape[0] < min_points:
+        raise InputError(f"{what}: need at least {min_points} points, got {X.shape[0]}.")
+    bad = ~np.isfinite(X).all(axis=1)
+    if bad.any():
+        rows = np.flatnonzero(bad)
+        raise InputError(
+            f"{what} contain NaN or inf in {rows.size} row(s) (first: {rows[:5].tolist()}). "
+            "Remove or repair those points before building anything on them."
+        )
+    return X
+
+
+def check_distinct(X: np.ndarray, *, what: str = "points", tol: float = 0.0) -> None:
+    """Raise :class:`InputError` if two rows of ``X`` coincide (within ``tol``)."""
+    from scipy.spatial import cKDTree
+
+    pairs = cKDTree(X).query_pairs(r=max(tol, 0.0), output_type="ndarray")
+    if len(pairs):
+        raise InputError(
+            f"{what} contain {len(pairs)} duplicate pair(s) (first: rows {pairs[0].tolist()}). "
+            "Remove duplicates, e.g. np.unique(points, axis=0)."
+        )

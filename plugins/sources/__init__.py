@@ -1,0 +1,1 @@
+"""pointatlas built-in sources plugins."""

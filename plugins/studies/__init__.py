@@ -1,0 +1,1 @@
+"""pointatlas built-in studies plugins."""

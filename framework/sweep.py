@@ -1,0 +1,98 @@
+"""Open a whole multirun as one Dataset, with the swept parameters as dimensions."""
+from __future__ import annotations
+
+import itertools
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from .errors import InputError
+from .results import RESULTS_NAME, open_run
+
+
+def parse_override(text: str) -> tuple[str, str]:
+    key, _, value = text.partition("=")
+    return key.lstrip("+~"), value
+
+
+def typed(value: str):
+    """'12' -> 12, '0.5' -> 0.5, other strings unchanged (for coordinates)."""
+    for kind in (int, float):
+        try:
+            return kind(value)
+        except ValueError:
+            pass
+    return value
+
+
+def run_dirs(sweep_dir: Path) -> list[Path]:
+    """Job directories of a multirun (those holding a results file), in job order."""
+    found = [p.parent for p in sweep_dir.glob(f"*/{RESULTS_NAME}")]
+
+    def order(p: Path):
+        return (0, int(p.name)) if p.name.isdigit() else (1, p.name)
+
+    return sorted(found, key=order)
+
+
+def swept_parameters(overrides: list[list[str]]) -> list[str]:
+    """Override keys whose value differs between runs."""
+    values: dict[str, set] = {}
+    for ov in overrides:
+        for key, value in map(parse_override, ov):
+            values.setdefault(key, set()).add(value)
+    keys = [k for k, v in values.items() if len(v) > 1]
+    # keys absent from some runs also vary
+    keys += [k for k in values if k not in keys and any(k not in dict(map(parse_override, o)) for o in overrides)]
+    return sorted(keys)
+
+
+def open_sweep(path: str | os.PathLike) -> xr.Dataset:
+    """One Dataset for a multirun directory.
+
+    When the runs form a full grid over the swept override keys, those keys are dimensions
+    (e.g. ``source.n_points``); otherwise runs are stacked along a ``run`` dim with the swept
+    values as coordinates. Attrs come from the first run, plus ``sweep_params``.
+    """
+    sweep_dir = Path(path)
+    dirs = run_dirs(sweep_dir) if sweep_dir.is_dir() else []
+    if not dirs:
+        raise InputError(
+            f"no runs with {RESULTS_NAME} under {sweep_dir}. Pass the directory of a "
+            "`pointatlas --multirun` sweep (it holds one numbered folder per job)."
+        )
+    runs = [open_run(d) for d in dirs]
+    overrides = [json.loads(ds.attrs.get("overrides", "[]")) for ds in runs]
+    keys = swept_parameters(overrides)
+    values = [[typed(dict(map(parse_override, ov)).get(k, "")) for k in keys] for ov in overrides]
+    stacked = xr.concat(
+        [ds.drop_attrs(deep=False) for ds in runs],
+        dim="run", coords="minimal", compat="override", join="outer",
+    )
+    stacked = stacked.assign_coords(run=("run", np.arange(len(runs)), {"long_name": "run index", "units": "1"}))
+    stacked = stacked.assign_coords(
+        run_dir=("run", [d.name for d in dirs], {"long_name": "run directory", "units": "1"})
+    )
+    for i, key in enumerate(keys):
+        stacked = stacked.assign_coords(
+            {key: ("run", [v[i] for v in values], {"long_name": f"swept parameter {key}", "units": "1"})}
+        )
+    axes = [sorted({v[i] for v in values}, key=str) for i in range(len(keys))]
+    grid = set(itertools.product(*axes))
+    is_grid = keys and len(grid) == len(values) and grid == {tuple(v) for v in values}
+    out = stacked
+    if is_grid:
+        out = stacked.drop_vars("run_dir")
+        if len(keys) == 1:
+            out = out.swap_dims(run=keys[0]).drop_vars("run").sortby(keys[0])
+        else:
+            out = out.set_index(run=keys).unstack("run")
+        for key in keys:
+            out[key].attrs.update({"long_name": f"swept parameter {key}", "units": "1"})
+    out.attrs = dict(runs[0].attrs)
+    out.attrs["sweep_params"] = json.dumps(keys)
+    out.attrs["sweep_dir"] = str(sweep_dir)
+    return out

@@ -1,0 +1,37 @@
+"""open_sweep: grids become dimensions, other sweeps a `run` dim."""
+import numpy as np
+
+import pointatlas
+from pointatlas.results import write_results
+
+
+def fake_run(path, overrides, value):
+    ds = __import__("xarray").Dataset({"err": ((), value, {"long_name": "error", "units": "1"})})
+    write_results(ds, path / "results.nc", {"overrides": overrides, "status": "completed"})
+
+
+def test_grid_sweep_has_parameter_dims(tmp_path):
+    k = 0
+    for n in (100, 200):
+        for e in ("pca", "isomap"):
+            fake_run(tmp_path / str(k), [f"source.n_points={n}", f"embedder={e}"], n * (1 + (e == "pca")))
+            k += 1
+    ds = pointatlas.open_sweep(tmp_path)
+    assert set(ds["err"].dims) == {"source.n_points", "embedder"}
+    assert float(ds["err"].sel({"source.n_points": 200, "embedder": "pca"})) == 400
+
+
+def test_single_parameter_sweep(tmp_path):
+    for k, n in enumerate((10, 20, 30)):
+        fake_run(tmp_path / str(k), [f"source.n_points={n}"], 1.0 / n)
+    ds = pointatlas.open_sweep(tmp_path)
+    assert ds["err"].dims == ("source.n_points",)
+    np.testing.assert_allclose(ds["err"].values, [0.1, 0.05, 1 / 30])
+
+
+def test_non_grid_sweep_uses_run_dim(tmp_path):
+    for k, ov in enumerate([["a=1", "b=1"], ["a=2", "b=1"], ["a=1", "b=2"]]):
+        fake_run(tmp_path / str(k), ov, float(k))
+    ds = pointatlas.open_sweep(tmp_path)
+    assert ds["err"].dims == ("run",)
+    assert list(ds["a"].values) == [1, 2, 1]

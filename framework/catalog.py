@@ -1,0 +1,514 @@
+"""The run catalog: one SQLite row per run, finished or failed, for experiment tracking.
+
+The catalog lives at ``<outputs_root>/catalog.sqlite`` (:func:`catalog_path`). The run pipeline
+calls :meth:`Catalog.start` when a run begins, :meth:`Catalog.finish` when it ends, and
+:meth:`Catalog.record_failure` for a run that failed before it could start (a bad config).
+``pointatlas-runs`` (:mod:`pointatlas.runs_cli`) reads it back with :meth:`Catalog.runs` and
+:meth:`Catalog.get`.
+
+Concurrency: the jobs of a multirun (joblib processes, submitit jobs) write to the same file at
+once. Every operation opens its own short-lived connection (nothing is held across ``fork``),
+runs one short transaction, and retries on "database is locked"; the journal is WAL with a
+60 s busy timeout. WAL needs a local filesystem (or one with working POSIX locks); on NFS put
+the outputs root on local disk or expect lock errors.
+
+Schema (version :data:`SCHEMA_VERSION`): ``runs`` (one row per run; overrides and params as
+JSON text), ``metrics`` (run_id, name, value; NULL stores NaN) and ``schema_version``.
+Standard library only, so importing this module stays fast.
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import random
+import re
+import sqlite3
+import time
+from dataclasses import dataclass, field
+from datetime import datetime
+from pathlib import Path
+from typing import Callable, Iterable, TypeVar
+
+from .errors import ConfigError, InputError, SchemaError
+
+#: Version of the catalog schema this module writes and reads.
+SCHEMA_VERSION = 1
+#: File name of the catalog inside the outputs root.
+CATALOG_FILENAME = "catalog.sqlite"
+#: Statuses stored in the catalog; "missing" is computed when the run directory is gone.
+STATUSES = ("running", "completed", "failed")
+MISSING = "missing"
+
+_BUSY_TIMEOUT_S = 60.0
+_RETRY_DEADLINE_S = 180.0
+
+_SCHEMA = """
+CREATE TABLE IF NOT EXISTS schema_version (version INTEGER NOT NULL);
+CREATE TABLE IF NOT EXISTS runs (
+    id TEXT PRIMARY KEY,
+    experiment TEXT NOT NULL,
+    overrides TEXT NOT NULL DEFAULT '[]',
+    params TEXT NOT NULL DEFAULT '{}',
+    status TEXT NOT NULL,
+    start_time TEXT,
+    end_time TEXT,
+    wall_time_s REAL,
+    path TEXT,
+    git_commit TEXT NOT NULL DEFAULT '',
+    error TEXT
+);
+CREATE TABLE IF NOT EXISTS metrics (
+    run_id TEXT NOT NULL REFERENCES runs(id) ON DELETE CASCADE,
+    name TEXT NOT NULL,
+    value REAL,
+    PRIMARY KEY (run_id, name)
+);
+CREATE INDEX IF NOT EXISTS runs_experiment ON runs(experiment);
+CREATE INDEX IF NOT EXISTS runs_start_time ON runs(start_time);
+CREATE INDEX IF NOT EXISTS metrics_name ON metrics(name);
+"""
+
+#: Migrations from version N to N+1 (executed inside one transaction). Empty at version 1.
+_MIGRATIONS: dict[int, Callable[[sqlite3.Connection], None]] = {}
+
+WHERE_SYNTAX = "key=value (e.g. embedder=isomap, source.n_points=2000)"
+METRIC_SYNTAX = "name<op>value with op one of < <= > >= = != (e.g. stress<10, relative_error<=1e-3)"
+_KEY = r"[A-Za-z_][A-Za-z0-9_.\-/@]*"
+_WHERE_RE = re.compile(rf"^\s*(?:\+\+|\+|~)?({_KEY})\s*=(.*)$")
+_METRIC_RE = re.compile(rf"^\s*({_KEY})\s*(<=|>=|!=|==|=|<|>)\s*(\S+)\s*$")
+_OPS: dict[str, Callable[[float, float], bool]] = {
+    "<": lambda a, b: a < b,
+    "<=": lambda a, b: a <= b,
+    ">": lambda a, b: a > b,
+    ">=": lambda a, b: a >= b,
+    "=": lambda a, b: a == b,
+    "==": lambda a, b: a == b,
+    "!=": lambda a, b: a != b,
+}
+
+T = TypeVar("T")
+
+
+def catalog_path(outputs_root: str | Path) -> Path:
+    """Path of the catalog file under an outputs root: ``<outputs_root>/catalog.sqlite``."""
+    return Path(outputs_root) / CATALOG_FILENAME
+
+
+@dataclass
+class RunRecord:
+    """One run as recorded in the catalog.
+
+    ``status`` is "running", "completed" or "failed", or "missing" when the recorded run
+    directory no longer exists (the stored status is kept in ``recorded_status``).
+    Times are ISO 8601 strings (UTC), ``wall_time_s`` in seconds; ``metrics`` maps metric
+    name to value (NaN for a non-finite value stored as NULL).
+    """
+
+    id: str
+    experiment: str
+    overrides: list[str] = field(default_factory=list)
+    params: dict[str, str] = field(default_factory=dict)
+    status: str = "running"
+    start_time: str | None = None
+    end_time: str | None = None
+    wall_time_s: float | None = None
+    metrics: dict[str, float] = field(default_factory=dict)
+    path: str | None = None
+    git_commit: str = ""
+    error: str | None = None
+    recorded_status: str = ""
+
+    def settings(self) -> dict[str, str]:
+        """Parameters and overrides as one ``key -> value`` map (overrides win)."""
+        merged = {str(k): str(v) for k, v in self.params.items()}
+        merged.update(overrides_as_dict(self.overrides))
+        return merged
+
+
+# ----------------------------------------------------------------------------- filters
+
+
+@dataclass(frozen=True)
+class WhereFilter:
+    """``key=value``: the run's override or param ``key`` equals ``value``."""
+
+    key: str
+    value: str
+
+    def matches(self, record: RunRecord) -> bool:
+        if self.key == "experiment" and _same_value(record.experiment, self.value):
+            return True
+        settings = record.settings()
+        return self.key in settings and _same_value(settings[self.key], self.value)
+
+
+@dataclass(frozen=True)
+class MetricFilter:
+    """``name<op>value``: the run has metric ``name`` and it satisfies the comparison."""
+
+    name: str
+    op: str
+    value: float
+
+    def matches(self, record: RunRecord) -> bool:
+        if self.name not in record.metrics:
+            return False
+        actual = record.metrics[self.name]
+        if actual is None or math.isnan(actual):
+            return self.op == "!=" and not math.isnan(self.value)
+        return _OPS[self.op](actual, self.value)
+
+
+def parse_where(text: str) -> WhereFilter:
+    """Parse a ``key=value`` filter; :class:`ConfigError` naming the valid syntax otherwise."""
+    match = _WHERE_RE.match(text) if isinstance(text, str) else None
+    if match is None or match.group(2).startswith("="):
+        raise ConfigError(f"bad where filter {text!r}: expected {WHERE_SYNTAX}")
+    return WhereFilter(match.group(1), _unquote(match.group(2).strip()))
+
+
+def parse_metric(text: str) -> MetricFilter:
+    """Parse a ``name<op>value`` threshold; :class:`ConfigError` naming the valid syntax otherwise."""
+    match = _METRIC_RE.match(text) if isinstance(text, str) else None
+    if match is None:
+        raise ConfigError(f"bad metric filter {text!r}: expected {METRIC_SYNTAX}")
+    name, op, raw = match.groups()
+    try:
+        value = float(raw)
+    except ValueError:
+        raise ConfigError(
+            f"bad metric filter {text!r}: {raw!r} is not a number; expected {METRIC_SYNTAX}"
+        ) from None
+    return MetricFilter(name, op, value)
+
+
+def overrides_as_dict(overrides: Iterable[str]) -> dict[str, str]:
+    """Hydra overrides as ``key -> value`` (``+``/``++`` prefixes dropped, ``~key`` -> ``"~"``)."""
+    result: dict[str, str] = {}
+    for item in overrides:
+        text = str(item).strip()
+        if text.startswith("~"):
+            result[text[1:].split("=", 1)[0]] = "~"
+            continue
+        text = text.lstrip("+")
+        key, sep, value = text.partition("=")
+        result[key.strip()] = _unquote(value.strip()) if sep else ""
+    return result
+
+
+def _unquote(text: str) -> str:
+    if len(text) >= 2 and text[0] == text[-1] and text[0] in "'\"":
+        return text[1:-1]
+    return text
+
+
+def _same_value(actual: str, wanted: str) -> bool:
+    actual = _unquote(str(actual).strip())
+    if actual == wanted:
+        return True
+    try:
+        return float(actual) == float(wanted)
+    except ValueError:
+        return False
+
+
+# ----------------------------------------------------------------------------- catalog
+
+
+class Catalog:
+    """The SQLite run catalog at ``path`` (created with its schema and parent dirs if missing)."""
+
+    def __init__(self, path: str | Path):
+        self.path = Path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._retry(self._init_schema)
+
+    def __repr__(self) -> str:
+        return f"Catalog({str(self.path)!r})"
+
+    # -- writing ---------------------------------------------------------------------------
+
+    def start(self, *, run_id: str, experiment: str, overrides: list[str], path: str | None,
+              git_commit: str, start_time: str, params: dict[str, str] | None = None) -> None:
+        """Record a run that has started (status "running"); re-using an id replaces the run."""
+        row = {
+            "id": _check_id(run_id), "experiment": str(experiment),
+            "overrides": _json_list(overrides), "params": _json_params(params),
+            "status": "running", "start_time": start_time, "end_time": None,
+            "wall_time_s": None, "path": _abs_path(path), "git_commit": git_commit or "",
+            "error": None,
+        }
+        self._write(lambda conn: _upsert(conn, row))
+
+    def finish(self, run_id: str, *, status: str, end_time: str, wall_time_s: float,
+               metrics: dict[str, float], error: str | None = None) -> None:
+        """Record the end of a started run: status ("completed"/"failed"), time and metrics."""
+        if status not in ("completed", "failed"):
+            raise ConfigError(f"finish status {status!r} is invalid: use 'completed' or 'failed'")
+        values = _metric_rows(metrics)
+
+        def write(conn: sqlite3.Connection) -> None:
+            cursor = conn.execute(
+                "UPDATE runs SET status=?, end_time=?, wall_time_s=?, error=? WHERE id=?",
+                (status, end_time, _float_or_none(wall_time_s), error, run_id),
+            )
+            if cursor.rowcount == 0:
+                raise InputError(f"run {run_id!r} is not in the catalog {self.path}: "
+                                 "call Catalog.start before Catalog.finish")
+            conn.execute("DELETE FROM metrics WHERE run_id=?", (run_id,))
+            conn.executemany("INSERT INTO metrics (run_id, name, value) VALUES (?, ?, ?)",
+                             [(run_id, name, value) for name, value in values])
+
+        self._write(write)
+
+    def record_failure(self, *, run_id: str, experiment: str, overrides: list[str],
+                       path: str | None, git_commit: str, start_time: str, end_time: str,
+                       error: str) -> None:
+        """Record a run that failed before it started (e.g. a bad config) as "failed"."""
+        row = {
+            "id": _check_id(run_id), "experiment": str(experiment),
+            "overrides": _json_list(overrides), "params": "{}", "status": "failed",
+            "start_time": start_time, "end_time": end_time,
+            "wall_time_s": _elapsed_s(start_time, end_time), "path": _abs_path(path),
+            "git_commit": git_commit or "", "error": error,
+        }
+        self._write(lambda conn: _upsert(conn, row))
+
+    # -- reading ---------------------------------------------------------------------------
+
+    def runs(self, *, experiment: str | None = None, status: str | None = None,
+             where: Iterable[str] = (), metric: Iterable[str] = (),
+             limit: int | None = None) -> list[RunRecord]:
+        """Runs matching every filter, oldest first (``limit``: keep only the newest N).
+
+        ``status`` may be "missing" (the computed status of runs whose directory is gone).
+        ``where``: ``key=value`` strings; ``metric``: ``name<op>value`` thresholds.
+        Bad filter syntax raises :class:`ConfigError`.
+        """
+        if isinstance(where, str):
+            where = [where]
+        if isinstance(metric, str):
+            metric = [metric]
+        where_filters = [parse_where(text) for text in where]
+        metric_filters = [parse_metric(text) for text in metric]
+        if status is not None and status not in (*STATUSES, MISSING):
+            raise ConfigError(f"status {status!r} is invalid: use one of "
+                              f"{', '.join((*STATUSES, MISSING))}")
+        if limit is not None and limit < 0:
+            raise ConfigError(f"limit {limit} is invalid: use a non-negative integer")
+        sql, args = "SELECT * FROM runs", []
+        if experiment is not None:
+            sql, args = sql + " WHERE experiment=?", [experiment]
+        sql += " ORDER BY start_time, id"
+        records = self._read(lambda conn: _records(conn, sql, args))
+        selected = [
+            r for r in records
+            if (status is None or r.status == status)
+            and all(f.matches(r) for f in where_filters)
+            and all(f.matches(r) for f in metric_filters)
+        ]
+        if limit is not None:
+            selected = selected[len(selected) - limit:] if limit else []
+        return selected
+
+    def get(self, run_id: str) -> RunRecord:
+        """The run with this id, or with this unique id prefix; :class:`InputError` otherwise."""
+        run_id = str(run_id).strip()
+        if not run_id:
+            raise InputError("empty run id: pass a run id or a unique prefix (see `pointatlas-runs list`)")
+
+        def lookup(conn: sqlite3.Connection) -> list[RunRecord]:
+            exact = _records(conn, "SELECT * FROM runs WHERE id=?", [run_id])
+            if exact:
+                return exact
+            return _records(conn, "SELECT * FROM runs WHERE substr(id, 1, ?)=? ORDER BY id LIMIT 6",
+                            [len(run_id), run_id])
+
+        found = self._read(lookup)
+        if not found:
+            raise InputError(f"no run with id or prefix {run_id!r} in {self.path}: "
+                             "see `pointatlas-runs list`")
+        if len(found) > 1:
+            shown = ", ".join(r.id for r in found[:5]) + (", ..." if len(found) > 5 else "")
+            raise InputError(f"run id prefix {run_id!r} is ambiguous ({shown}): give more characters")
+        return found[0]
+
+    def ids(self) -> list[str]:
+        """Every run id in the catalog (for shortest-unique-prefix display)."""
+        return self._read(lambda conn: [row[0] for row in conn.execute("SELECT id FROM runs")])
+
+    # -- plumbing --------------------------------------------------------------------------
+
+    def _connect(self) -> sqlite3.Connection:
+        conn = sqlite3.connect(str(self.path), timeout=_BUSY_TIMEOUT_S, isolation_level=None)
+        conn.row_factory = sqlite3.Row
+        conn.execute(f"PRAGMA busy_timeout={int(_BUSY_TIMEOUT_S * 1000)}")
+        conn.execute("PRAGMA foreign_keys=ON")
+        conn.execute("PRAGMA synchronous=NORMAL")  # safe with WAL; may drop the last commit on power loss
+        return conn
+
+    def _init_schema(self) -> None:
+        conn = self._connect()
+        try:
+            if _current_version(conn) == SCHEMA_VERSION:
+                return  # ready: no write needed (works on a read-only copy too)
+            if conn.execute("PRAGMA journal_mode").fetchone()[0].lower() != "wal":
+                conn.execute("PRAGMA journal_mode=WAL")
+            conn.execute("BEGIN IMMEDIATE")
+            for statement in filter(str.strip, _SCHEMA.split(";")):
+                conn.execute(statement)
+            row = conn.execute("SELECT MAX(version) FROM schema_version").fetchone()
+            version = row[0]
+            if version is None:
+                conn.execute("INSERT INTO schema_version (version) VALUES (?)", (SCHEMA_VERSION,))
+            elif version > SCHEMA_VERSION:
+                conn.execute("ROLLBACK")
+                raise SchemaError(f"catalog {self.path} has schema version {version}, newer than "
+                                  f"the {SCHEMA_VERSION} this pointatlas reads: upgrade pointatlas")
+            else:
+                while version < SCHEMA_VERSION:
+                    _MIGRATIONS[version](conn)
+                    version += 1
+                conn.execute("UPDATE schema_version SET version=?", (SCHEMA_VERSION,))
+            conn.execute("COMMIT")
+        except BaseException:
+            if conn.in_transaction:
+                conn.execute("ROLLBACK")
+            raise
+        finally:
+            conn.close()
+
+    def _write(self, operation: Callable[[sqlite3.Connection], None]) -> None:
+        def attempt() -> None:
+            conn = self._connect()
+            try:
+                conn.execute("BEGIN IMMEDIATE")
+                operation(conn)
+                conn.execute("COMMIT")
+            except BaseException:
+                if conn.in_transaction:
+                    conn.execute("ROLLBACK")
+                raise
+            finally:
+                conn.close()
+
+        self._retry(attempt)
+
+    def _read(self, operation: Callable[[sqlite3.Connection], T]) -> T:
+        def attempt() -> T:
+            conn = self._connect()
+            try:
+                return operation(conn)
+            finally:
+                conn.close()
+
+        return self._retry(attempt)
+
+    @staticmethod
+    def _retry(attempt: Callable[[], T]) -> T:
+        deadline = time.monotonic() + _RETRY_DEADLINE_S
+        delay = 0.01
+        while True:
+            try:
+                return attempt()
+            except sqlite3.OperationalError as exc:
+                message = str(exc).lower()
+                if ("locked" not in message and "busy" not in message) or time.monotonic() > deadline:
+                    raise
+            time.sleep(delay * (0.5 + random.random()))
+            delay = min(delay * 2, 1.0)
+
+
+# ----------------------------------------------------------------------------- helpers
+
+
+def _current_version(conn: sqlite3.Connection) -> int | None:
+    exists = conn.execute(
+        "SELECT 1 FROM sqlite_master WHERE type='table' AND name='schema_version'").fetchone()
+    if not exists:
+        return None
+    return conn.execute("SELECT MAX(version) FROM schema_version").fetchone()[0]
+
+
+def _upsert(conn: sqlite3.Connection, row: dict) -> None:
+    """Insert or replace the run row and drop its old metrics (a re-used id starts afresh)."""
+    columns = list(row)
+    updates = ", ".join(f"{c}=excluded.{c}" for c in columns if c != "id")
+    conn.execute(
+        f"INSERT INTO runs ({', '.join(columns)}) VALUES ({', '.join('?' * len(columns))}) "
+        f"ON CONFLICT(id) DO UPDATE SET {updates}",
+        [row[c] for c in columns],
+    )
+    conn.execute("DELETE FROM metrics WHERE run_id=?", (row["id"],))
+
+
+def _records(conn: sqlite3.Connection, sql: str, args: list) -> list[RunRecord]:
+    rows = conn.execute(sql, args).fetchall()
+    if not rows:
+        return []
+    metrics: dict[str, dict[str, float]] = {}
+    ids = [row["id"] for row in rows]
+    for start in range(0, len(ids), 500):
+        chunk = ids[start:start + 500]
+        query = (f"SELECT run_id, name, value FROM metrics WHERE run_id IN "
+                 f"({', '.join('?' * len(chunk))}) ORDER BY rowid")
+        for run_id, name, value in conn.execute(query, chunk):
+            metrics.setdefault(run_id, {})[name] = math.nan if value is None else float(value)
+    return [_record(row, metrics.get(row["id"], {})) for row in rows]
+
+
+def _record(row: sqlite3.Row, metrics: dict[str, float]) -> RunRecord:
+    stored = row["status"]
+    path = row["path"]
+    status = MISSING if path and not os.path.exists(path) else stored
+    return RunRecord(
+        id=row["id"], experiment=row["experiment"], overrides=list(json.loads(row["overrides"])),
+        params=dict(json.loads(row["params"])), status=status, start_time=row["start_time"],
+        end_time=row["end_time"], wall_time_s=row["wall_time_s"], metrics=metrics, path=path,
+        git_commit=row["git_commit"], error=row["error"], recorded_status=stored,
+    )
+
+
+def _check_id(run_id: str) -> str:
+    if not isinstance(run_id, str) or not run_id.strip():
+        raise ConfigError(f"run id {run_id!r} is invalid: use a non-empty string")
+    return run_id
+
+
+def _json_list(items: Iterable[str] | None) -> str:
+    return json.dumps([str(item) for item in (items or [])])
+
+
+def _json_params(params: dict[str, str] | None) -> str:
+    return json.dumps({str(k): str(v) for k, v in (params or {}).items()}, sort_keys=True)
+
+
+def _abs_path(path: str | os.PathLike | None) -> str | None:
+    return None if path is None or str(path) == "" else os.path.abspath(os.fspath(path))
+
+
+def _float_or_none(value: float | None) -> float | None:
+    if value is None:
+        return None
+    value = float(value)
+    return None if math.isnan(value) else value
+
+
+def _metric_rows(metrics: dict[str, float] | None) -> list[tuple[str, float | None]]:
+    rows = []
+    for name, value in (metrics or {}).items():
+        try:
+            number = float(value)
+        except (TypeError, ValueError):
+            raise ConfigError(f"metric {name!r} = {value!r} is not a number: metrics must be "
+                              "floats") from None
+        rows.append((str(name), None if math.isnan(number) else number))
+    return rows
+
+
+def _elapsed_s(start_time: str | None, end_time: str | None) -> float | None:
+    try:
+        return (datetime.fromisoformat(end_time) - datetime.fromisoformat(start_time)).total_seconds()
+    except (TypeError, ValueError):
+        return None

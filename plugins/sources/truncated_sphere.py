@@ -1,0 +1,123 @@
+"""The truncated sphere of thesis Fig. 5 and its quarter (Table 1, thesis L150-165, L2085).
+
+The thesis shows "points quasi-uniformly distributed on a truncated sphere", a large
+portion of a sphere with the topology of a disc, and the quarter of it used for the
+stress table of the affine isometric correction; it does not give the cut. We use the
+sphere of radius R with the polar cap z > cut·R removed (default cut = 0.5, i.e. the
+cap of polar angle 60°), and for the quarter additionally x ≥ 0, y ≥ 0.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar, Optional
+
+import numpy as np
+
+from .lattices import allocate_counts, fibonacci_band, staggered_rows
+from .sphere import sphere_parameters, spherical_to_cartesian
+from .surface_source import COMMON_CONSTRAINTS, SurfaceSource, require, require_positive
+
+
+def spherical_rows(n: int, cut: float, phi_span: float):
+    """Structured lattice on the zone z ≤ cut (unit sphere), azimuth in [0, phi_span].
+
+    Rows are equally spaced in polar angle (constant meridian spacing h); row j gets a
+    number of points proportional to its length sinθ_j·phi_span (largest remainder, total
+    exactly n), equally spaced at cell centres so the two meridian edges are half a spacing
+    away. Returns ``(z, phi)``.
+    """
+    theta_cut = np.arccos(cut)
+    area = (1.0 + cut) * phi_span
+    h = np.sqrt(area / n)
+    n_rows = max(1, int(round((np.pi - theta_cut) / h)))
+    theta_rows = theta_cut + (np.arange(n_rows) + 0.5) * (np.pi - theta_cut) / n_rows
+    counts = allocate_counts(n, np.sin(theta_rows))
+    row, phi = staggered_rows(counts, phi_span, periodic=False)
+    return np.cos(theta_rows[row]), phi
+
+
+class TruncatedSphere(SurfaceSource):
+    """Sphere of radius ``radius`` without the polar cap z > cut·radius (a disc topologically).
+
+    structured: Fibonacci lattice restricted to the zone (equal-area, quasi-uniform).
+    random: uniform w.r.t. area (z uniform in [-R, cut·R] by Archimedes, φ uniform).
+    Exact: area 2πR²(1 + cut), χ = 1, genus 0, one boundary circle of radius R·sqrt(1-cut²).
+    """
+
+    @dataclass
+    class Config:
+        n_points: int = 1000
+        sampling: str = "structured"
+        radius: float = 1.0
+        cut: float = 0.5
+        n_markers: Optional[int] = None
+
+    description: ClassVar[str] = "Sphere with the polar cap z > cut·R removed (thesis Fig. 5)."
+    parameter_constraints: ClassVar[dict[str, str]] = {
+        **COMMON_CONSTRAINTS, "radius": "finite number > 0",
+        "cut": "number in (-1, 1): the cap z > cut·radius is removed"}
+    name: ClassVar[str] = "truncated_sphere"
+    phi_span: ClassVar[float] = 2.0 * np.pi
+
+    def __init__(self, *, n_points: int = 1000, sampling: str = "structured",
+                 radius: float = 1.0, cut: float = 0.5, n_markers: Optional[int] = None):
+        self.n_points = n_points
+        self.sampling = sampling
+        self.radius = radius
+        self.cut = cut
+        self.n_markers = n_markers
+
+    def _check(self) -> None:
+        require_positive("radius", self.radius)
+        require(
+            isinstance(self.cut, (int, float)) and not isinstance(self.cut, bool)
+            and -1.0 < self.cut < 1.0,
+            "cut", self.cut, "must be in (-1, 1) (fraction of the radius)",
+            "Use e.g. cut=0.5 to remove the cap above z = R/2.",
+        )
+
+    def _structured(self, n):
+        return fibonacci_band(n, -1.0, float(self.cut), self.phi_span)
+
+    def _sample(self, n, sampling, rng):
+        if sampling == "structured":
+            z, phi = self._structured(n)
+        else:
+            z = rng.uniform(-1.0, float(self.cut), n)
+            phi = rng.uniform(0.0, self.phi_span, n)
+        return spherical_to_cartesian(self.radius, z, phi), sphere_parameters(z, phi)
+
+    def _exact(self):
+        R, c = float(self.radius), float(self.cut)
+        return {
+            "area": self.phi_span * R**2 * (1.0 + c),
+            "radius": R,
+            "cut_height": c * R,
+            "euler_characteristic": 1,
+            "genus": 0,
+            "total_gaussian_curvature": self.phi_span * (1.0 + c),
+        }
+
+
+class QuarterTruncatedSphere(TruncatedSphere):
+    """The x ≥ 0, y ≥ 0 quarter of the truncated sphere (thesis Table 1, Fig. 6).
+
+    structured: rows equally spaced in polar angle with counts proportional to their
+    length (quasi-uniform, exactly n_points). random: uniform w.r.t. area.
+    Exact: area πR²(1 + cut)/2, χ = 1 (a disc), genus 0.
+    """
+
+    @dataclass
+    class Config:
+        n_points: int = 1000
+        sampling: str = "structured"
+        radius: float = 1.0
+        cut: float = 0.5
+        n_markers: Optional[int] = None
+
+    description: ClassVar[str] = "Quarter (x, y ≥ 0) of the truncated sphere (thesis Table 1)."
+    name: ClassVar[str] = "quarter_truncated_sphere"
+    phi_span: ClassVar[float] = 0.5 * np.pi
+
+    def _structured(self, n):
+        return spherical_rows(n, float(self.cut), self.phi_span)

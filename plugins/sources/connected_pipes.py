@@ -17,9 +17,7 @@ from dataclasses import dataclass
 from typing import ClassVar, Optional
 
 import numpy as np
-from scipy.stats import qmc
 
-from .lattices import farthest_point_order
 from .surface_source import COMMON_CONSTRAINTS, SurfaceSource, require, require_positive
 
 #: Candidates per output point for the structured (farthest-point) selection.
@@ -140,6 +138,10 @@ class ConnectedPipes(SurfaceSource):
             C = thin_shell_candidates(lambda m: rng.uniform(lo, hi, (m, 3)), n, c, half_width)
             X = project_to_surface(C, c)
         else:
+            from scipy.stats import qmc
+
+            from .farthest_point import farthest_point_order
+
             halton = qmc.Halton(d=3, scramble=False)
             halton.fast_forward(1)  # skip the corner (0, 0, 0)
             C = thin_shell_candidates(lambda m: lo + (hi - lo) * halton.random(m),

@@ -5,7 +5,6 @@ Pure functions on arrays; no randomness. Lengths are in the units of the caller.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 #: 1/φ, the golden-ratio conjugate; i·(1/φ) mod 1 is the most evenly spread 1-D sequence.
 GOLDEN_FRACTION = (np.sqrt(5.0) - 1.0) / 2.0
@@ -70,32 +69,3 @@ def rows_for_rectangle(n: int, length: float, width: float) -> int:
     with equal spacing in both directions: spacing h = sqrt(length·width/n)."""
     h = np.sqrt(length * width / n)
     return int(max(1, min(n, round(width / h))))
-
-
-@njit(cache=True)
-def farthest_point_order(X: np.ndarray, n: int, start: int) -> np.ndarray:
-    """Greedy farthest-point selection of ``n`` rows of ``X`` (Gonzalez' algorithm).
-
-    Each new point maximises its distance to the points already chosen; the result is
-    quasi-uniform (a Poisson-disk-like set: the minimum spacing is at least half the covering
-    radius). Cost O(n · len(X)).
-    """
-    m = X.shape[0]
-    d2 = np.full(m, np.inf)
-    chosen = np.empty(n, dtype=np.int64)
-    current = start
-    for k in range(n):
-        chosen[k] = current
-        best, best_d = 0, -1.0
-        for i in range(m):
-            s = 0.0
-            for c in range(X.shape[1]):
-                diff = X[i, c] - X[current, c]
-                s += diff * diff
-            if s < d2[i]:
-                d2[i] = s
-            if d2[i] > best_d:
-                best_d = d2[i]
-                best = i
-        current = best
-    return chosen

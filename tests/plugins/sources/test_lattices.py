@@ -1,7 +1,8 @@
 import numpy as np
 import pytest
 
-from pointatlas_sources.lattices import allocate_counts, farthest_point_order, fibonacci_band
+from pointatlas_sources.farthest_point import farthest_point_order
+from pointatlas_sources.lattices import allocate_counts, fibonacci_band
 
 
 @pytest.mark.parametrize("n", [1, 7, 100, 1001])

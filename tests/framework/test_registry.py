@@ -85,3 +85,10 @@ def test_builtin_plugins_are_registered_through_entry_points():
     assert ("pointatlas.embedders", "isomap") in names
     assert ("pointatlas.sources", "swiss_roll") in names
     assert ("pointatlas.studies", "embedding") in names
+
+
+def test_every_builtin_plugin_imports():
+    """A broken built-in plugin would otherwise only warn and vanish from the lists."""
+    broken = [row for row in pointatlas.plugins() if row["distribution"] == "pointatlas"
+              and row["description"].startswith("BROKEN")]
+    assert broken == []

@@ -1,0 +1,1 @@
+"""An example third-party pointatlas plugin (see the README's plugin guide)."""

@@ -1,0 +1,119 @@
+"""What a study sees of its run: resolved config, seeded RNGs, plugins, output dir, logger."""
+from __future__ import annotations
+
+import dataclasses
+import logging
+import zlib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .errors import ConfigError
+from .progress import Progress
+from .registry import load_plugin
+
+
+def plugin_kwargs(node: Any) -> dict:
+    """A plugin's config node (DictConfig, dataclass or dict) as plain keyword arguments."""
+    if node is None:
+        return {}
+    if dataclasses.is_dataclass(node) and not isinstance(node, type):
+        return dataclasses.asdict(node)
+    try:
+        from omegaconf import DictConfig, OmegaConf
+
+        if isinstance(node, DictConfig):
+            return OmegaConf.to_container(node, resolve=True)  # type: ignore[return-value]
+    except ImportError:  # pragma: no cover
+        pass
+    return dict(node)
+
+
+@dataclass
+class RunContext:
+    """The run as a study sees it.
+
+    Attributes
+    ----------
+    config : resolved run config (nested dicts), keys as in ``conf/``
+    choices : family -> selected plugin name (``{"embedder": "isomap", ...}``)
+    seed : the run's ``seed``; every RNG derives from it
+    run_dir : where the run writes its files
+    """
+
+    config: dict
+    choices: dict[str, str]
+    seed: int = 0
+    run_dir: Path = Path(".")
+    log: logging.Logger = field(default_factory=lambda: logging.getLogger("pointatlas.run"))
+    timings: dict[str, float] = field(default_factory=dict)
+
+    def rng(self, stream: str = "") -> np.random.Generator:
+        """A generator seeded by the run seed and a stream name (independent streams)."""
+        key = zlib.crc32(stream.encode())
+        return np.random.default_rng(np.random.SeedSequence([self.seed, key]))
+
+    def plugin_name(self, family: str) -> str:
+        name = self.choices.get(family)
+        if not name:
+            raise ConfigError(
+                f"this run selects no {family} plugin but its study needs one. Add "
+                f"`{family}=<name>` (list them with `pointatlas-runs plugins` or "
+                f"`python -c 'import pointatlas; print(pointatlas.plugins())'`)."
+            )
+        return name
+
+    def plugin(self, family: str, **overrides: Any):
+        """The selected plugin of ``family`` built from its config (plus ``overrides``)."""
+        name = self.plugin_name(family)
+        kwargs = {**plugin_kwargs(self.config.get(family)), **overrides}
+        return self.make(family, name, **kwargs)
+
+    def make(self, family: str, name: str, /, **kwargs: Any):
+        """Build any installed plugin by name; config defaults fill missing keywords."""
+        cls = load_plugin(family, name)
+        config = getattr(cls, "Config", None)
+        if config is not None:
+            valid = {f.name for f in dataclasses.fields(config)}
+            bad = sorted(set(kwargs) - valid)
+            if bad:
+                raise ConfigError(
+                    f"{family} plugin {name!r} has no setting(s) {bad}. Valid keys: "
+                    f"{', '.join(sorted(valid))}."
+                )
+            kwargs = {**dataclasses.asdict(config()), **kwargs} if _constructible(config) else kwargs
+        return cls(**kwargs)
+
+    def progress(self, iterable=None, *, total: int | None = None, desc: str = "work") -> Progress:
+        return Progress(iterable, total=total, desc=desc, logger=self.log)
+
+    def timed(self, label: str):
+        """Context manager adding the wall time of a block to ``timings[label]`` (s)."""
+        return _Timer(self.timings, label)
+
+
+def _constructible(config: type) -> bool:
+    try:
+        config()
+    except TypeError:
+        return False
+    return True
+
+
+class _Timer:
+    def __init__(self, store: dict, label: str):
+        self.store, self.label = store, label
+
+    def __enter__(self):
+        import time
+
+        self.t0 = time.perf_counter()
+        return self
+
+    def __exit__(self, *exc):
+        import time
+
+        self.store[self.label] = self.store.get(self.label, 0.0) + time.perf_counter() - self.t0
+        return False

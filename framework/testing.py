@@ -1,0 +1,147 @@
+"""Plugin conformance suite: run it on your plugin (our tests run it on every built-in one).
+
+>>> from pointatlas.testing import check_plugin
+>>> check_plugin("embedders", MyEmbedder)          # doctest: +SKIP
+
+Each ``check_*`` raises ``AssertionError`` naming the broken rule.
+"""
+from __future__ import annotations
+
+import dataclasses
+import inspect
+from typing import Any
+
+import numpy as np
+
+from .registry import FAMILIES, group_name
+
+
+def check_contract(cls: type) -> None:
+    """Rules every plugin follows: a Config dataclass mirrored by a keyword-only ``__init__``
+    that only stores, and a one-line description."""
+    name = cls.__name__
+    config = getattr(cls, "Config", None)
+    assert config is not None and dataclasses.is_dataclass(config), (
+        f"{name} must define a class attribute `Config` that is a @dataclass")
+    desc = getattr(cls, "description", None)
+    assert isinstance(desc, str) and desc.strip() and "\n" not in desc.strip(), (
+        f"{name}.description must be a one-line string")
+    params = inspect.signature(cls.__init__).parameters
+    fields = {f.name for f in dataclasses.fields(config)}
+    positional = [p for p, v in params.items() if p != "self" and v.kind in (
+        v.POSITIONAL_ONLY, v.POSITIONAL_OR_KEYWORD)]
+    assert not positional, f"{name}.__init__ must be keyword-only (found positional {positional})"
+    named = {p for p, v in params.items() if v.kind == v.KEYWORD_ONLY}
+    assert named == fields, (
+        f"{name}.__init__ keywords {sorted(named)} differ from its Config fields {sorted(fields)}")
+    try:
+        defaults = dataclasses.asdict(config())
+    except TypeError:
+        return  # a Config with required fields: nothing more to check without values
+    obj = cls(**defaults)
+    for key, value in defaults.items():
+        assert hasattr(obj, key) and _same(getattr(obj, key), value), (
+            f"{name}.__init__ must store {key!r} unchanged (scikit-learn convention)")
+    _check_hydra(config, name)
+
+
+def _same(a, b) -> bool:
+    try:
+        return bool(a == b) if not isinstance(a, float) or a == a else b != b
+    except Exception:  # noqa: BLE001
+        return a is b
+
+
+def _check_hydra(config: type, name: str) -> None:
+    from omegaconf import OmegaConf
+
+    try:
+        OmegaConf.structured(config)
+    except Exception as exc:  # noqa: BLE001
+        raise AssertionError(f"{name}.Config is not a valid Hydra structured config: {exc}") from exc
+
+
+def _swiss_roll(n: int = 400, seed: int = 0) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    t = 1.5 * np.pi * (1 + 2 * rng.random(n))
+    h = 10 * rng.random(n)
+    return np.column_stack([t * np.cos(t), h, t * np.sin(t)])
+
+
+def check_source(cls: type, **kwargs: Any) -> None:
+    from .pointcloud import PointCloud
+
+    check_contract(cls)
+    a = cls(**kwargs).load(np.random.default_rng(1))
+    b = cls(**kwargs).load(np.random.default_rng(1))
+    assert isinstance(a, PointCloud), f"{cls.__name__}.load must return a PointCloud"
+    assert np.isfinite(a.points).all(), f"{cls.__name__}.load returned non-finite points"
+    np.testing.assert_array_equal(a.points, b.points, err_msg=(
+        f"{cls.__name__}: the same rng seed must give the same points"))
+
+
+def check_embedder(cls: type, **kwargs: Any) -> None:
+    check_contract(cls)
+    X = _swiss_roll()
+    est = cls(**kwargs)
+    assert est.fit(X) is est, f"{cls.__name__}.fit must return self"
+    Y = np.asarray(est.embedding_)
+    d = getattr(est, "n_components", 2)
+    assert Y.shape == (len(X), d), f"{cls.__name__}.embedding_ has shape {Y.shape}, not {(len(X), d)}"
+    assert np.isfinite(Y).all(), f"{cls.__name__} produced non-finite embedding values"
+    Z = np.asarray(cls(**kwargs).fit_transform(X))
+    assert Z.shape == Y.shape, f"{cls.__name__}.fit_transform must return (n, n_components)"
+    bad = X.copy()
+    bad[3, 1] = np.nan
+    try:
+        cls(**kwargs).fit(bad)
+    except (ValueError, ArithmeticError):
+        pass
+    else:
+        raise AssertionError(f"{cls.__name__}.fit accepted NaN coordinates; it must raise")
+
+
+def check_approximant(cls: type, *, dim: int = 2, reproduces_linear: bool = False, **kwargs: Any) -> None:
+    """Partition of unity (and linear reproduction when claimed) at interior points."""
+    check_contract(cls)
+    rng = np.random.default_rng(0)
+    nodes = rng.random((150, dim))
+    points = 0.3 + 0.4 * rng.random((40, dim))
+    basis = cls(**kwargs).fit(nodes).evaluate(points, order=1)
+    assert basis.indptr.shape == (len(points) + 1,), "indptr must have m+1 entries"
+    rows = np.repeat(np.arange(len(points)), np.diff(basis.indptr))
+    total = np.bincount(rows, weights=basis.values, minlength=len(points))
+    np.testing.assert_allclose(total, 1.0, atol=1e-8, err_msg="basis functions must sum to 1")
+    assert (basis.values >= -1e-14).all(), "basis function values must be non-negative"
+    assert basis.gradients is not None and basis.gradients.shape == (len(basis.values), dim)
+    gsum = np.zeros((len(points), dim))
+    np.add.at(gsum, rows, basis.gradients)
+    np.testing.assert_allclose(gsum, 0.0, atol=1e-7, err_msg="gradients must sum to 0")
+    if reproduces_linear:
+        rec = np.zeros((len(points), dim))
+        np.add.at(rec, rows, basis.values[:, None] * nodes[basis.indices])
+        np.testing.assert_allclose(rec, points, atol=1e-8, err_msg="linear reproduction fails")
+
+
+def check_physics(cls: type, **kwargs: Any) -> None:
+    check_contract(cls)
+    assert callable(getattr(cls, "solve", None)), f"{cls.__name__} must define solve(ctx, ...)"
+
+
+def check_study(cls: type, **kwargs: Any) -> None:
+    check_contract(cls)
+    assert callable(getattr(cls, "run", None)), f"{cls.__name__} must define run(ctx)"
+
+
+CHECKS = {
+    "source": check_source,
+    "embedder": check_embedder,
+    "approximant": check_approximant,
+    "physics": check_physics,
+    "study": check_study,
+}
+
+
+def check_plugin(family: str, cls: type, **kwargs: Any) -> None:
+    """Run the conformance checks of ``family`` ('embedders', 'embedder', ...) on ``cls``."""
+    CHECKS[FAMILIES[group_name(family)]](cls, **kwargs)

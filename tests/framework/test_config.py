@@ -1,0 +1,32 @@
+"""Every config group composes, and plugin configs are checked against their dataclass."""
+import pytest
+from hydra import compose, initialize_config_dir
+
+from pointatlas.config import CONF_DIR, experiments, register_configs
+from pointatlas.registry import FAMILIES, load_all
+
+register_configs()
+
+
+def choices():
+    out = []
+    for group, family in FAMILIES.items():
+        out += [(family, name) for name in load_all(group)]
+    out += [("experiment", name) for name in experiments()]
+    out += [("sweep", p.stem) for p in (CONF_DIR / "sweep").glob("*.yaml")]
+    out += [("hydra/launcher", p.stem) for p in (CONF_DIR / "hydra" / "launcher").glob("*.yaml")]
+    return out
+
+
+@pytest.mark.parametrize("group,name", choices())
+def test_every_config_group_composes(group, name):
+    with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
+        cfg = compose("config", overrides=[f"{group}={name}"], return_hydra_config=True)
+    assert cfg.hydra.runtime.choices[group] == name
+
+
+def test_experiments_have_usage_comment_and_reference():
+    for name, path in experiments().items():
+        text = path.read_text()
+        assert text.startswith("# @package _global_"), name
+        assert f"# Usage: pointatlas experiment={name}" in text, name

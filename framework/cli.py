@@ -145,6 +145,11 @@ def main(argv: list[str] | None = None) -> None:
     import hydra
 
     argv = sys.argv[1:] if argv is None else argv
+    if argv and argv[0] in ("--help", "-h"):
+        from .cli_help import help_text
+
+        print(help_text())
+        return
     overrides, multirun, info = split_argv(argv)
     try:
         register_configs()

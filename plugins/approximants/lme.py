@@ -1,0 +1,191 @@
+"""Local max-ent (LME) approximants, nodal locality β_a = γ/h_a² (thesis Box 2, Paper 1 §2.4).
+
+p_a(x) = exp(-β_a|x - x_a|² + λ*·(x - x_a)) / Z(x, λ*),  λ* = argmin_λ log Z(x, λ):
+non-negative, partition of unity, linear reproduction (Σ p_a x_a = x), C^∞, defined only
+inside the convex hull of the nodes. Kernels and derivative formulas: :mod:`.lme_kernels`.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar, Optional
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from pointatlas.basis import BasisFunctions
+from pointatlas.errors import ConfigError, InputError
+
+from . import lme_kernels as K
+from .support import SupportGrid, locality, nodal_spacing, support_radius
+from .validation import (
+    check_nodes,
+    check_order,
+    check_outside,
+    check_points,
+    check_positive,
+    check_tol,
+    compact_rows,
+    replace_rows,
+    spacing_neighbors,
+)
+
+
+class LocalMaxEnt:
+    """Local max-ent basis functions on scattered nodes in any dimension d.
+
+    Parameters
+    ----------
+    gamma : aspect ratio γ = β_a h_a² (larger: sharper, more local; → ∞ gives Delaunay hats).
+    tol : support cut-off; node a is ignored where exp(-β_a|x - x_a|²) < tol.
+    n_spacing_neighbors : h_a is the mean distance from node a to this many nearest nodes;
+        None (default) means 2·d, which gives h_a = h exactly on a Cartesian grid of spacing h.
+    newton_tol : Newton on λ stops when |r| = |Σ p_a (x - x_a)| < newton_tol · h_ref,
+        h_ref = median h_a (so the test is independent of the length unit).
+    max_iter : Newton iterations before a point is declared outside the hull.
+    outside : 'error' raises InputError on points outside the convex hull of the nodes;
+        'flag' marks them in ``BasisFunctions.outside`` and leaves their rows empty.
+
+    The support nodes of x are those with |x - x_a| < r_a = sqrt(-ln(tol)/β_a). Where the
+    dual cannot be solved on them (strongly varying h_a: x in a gap between clusters), x is
+    solved again on every node within max r_a, then twice that, ... (see ``_retry``);
+    only then is it declared outside the hull.
+    """
+
+    @dataclass
+    class Config:
+        gamma: float = 0.8
+        tol: float = 1e-10
+        n_spacing_neighbors: Optional[int] = None
+        newton_tol: float = 1e-12
+        max_iter: int = 100
+        outside: str = "error"
+
+    description: ClassVar[str] = "Local max-ent basis functions (nodal locality β_a = γ/h_a²)."
+    parameter_constraints: ClassVar[dict[str, str]] = {
+        "gamma": "float > 0",
+        "tol": "float in (0, 1)",
+        "n_spacing_neighbors": "int >= 1 and < number of nodes, or None (2*d)",
+        "newton_tol": "float > 0",
+        "max_iter": "int >= 1",
+        "outside": "'error' or 'flag'",
+    }
+
+    def __init__(self, *, gamma: float = 0.8, tol: float = 1e-10,
+                 n_spacing_neighbors: Optional[int] = None, newton_tol: float = 1e-12,
+                 max_iter: int = 100, outside: str = "error"):
+        self.gamma = gamma
+        self.tol = tol
+        self.n_spacing_neighbors = n_spacing_neighbors
+        self.newton_tol = newton_tol
+        self.max_iter = max_iter
+        self.outside = outside
+
+    def _check_config(self):
+        name = "LocalMaxEnt"
+        check_positive("gamma", self.gamma, plugin=name)
+        check_tol(self.tol, plugin=name)
+        check_positive("newton_tol", self.newton_tol, plugin=name)
+        check_outside(self.outside, plugin=name)
+        if isinstance(self.max_iter, bool) or not isinstance(self.max_iter, int) \
+                or self.max_iter < 1:
+            raise ConfigError(
+                f"LocalMaxEnt: max_iter = {self.max_iter!r} is invalid; it must be an integer "
+                ">= 1. Use e.g. max_iter=100."
+            )
+
+    def fit(self, nodes) -> "LocalMaxEnt":
+        """Store the (n, d) nodes; compute h_a, β_a = γ/h_a², cut-off radii and cell lists."""
+        self._check_config()
+        X = check_nodes(nodes, plugin="LocalMaxEnt")
+        n, d = X.shape
+        k = spacing_neighbors(self.n_spacing_neighbors, d, n, plugin="LocalMaxEnt")
+        self.tree_ = cKDTree(X)
+        self.nodes_ = X
+        self.spacing_ = nodal_spacing(self.tree_, X, k)
+        self.beta_ = locality(self.spacing_, float(self.gamma))
+        self.radius_ = support_radius(self.beta_, float(self.tol))
+        self.grid_ = SupportGrid(X, self.radius_)
+        self.h_ref_ = float(np.median(self.spacing_))
+        return self
+
+    @property
+    def n_nodes(self) -> int:
+        return self.nodes_.shape[0]
+
+    def evaluate(self, points, order: int = 0) -> BasisFunctions:
+        """p_a at the (m, d) points, with gradients (order ≥ 1) and Hessians (order 2)."""
+        if not hasattr(self, "nodes_"):
+            raise InputError("LocalMaxEnt.evaluate called before fit; call fit(nodes) first.")
+        self._check_config()
+        order = check_order(order, 2, plugin="LocalMaxEnt")
+        d = self.nodes_.shape[1]
+        x = check_points(points, d, plugin="LocalMaxEnt")
+        indptr, arrays, status = self._solve(self.grid_.cells(x), order)
+        bad = status != K.OK
+        if bad.any():
+            indptr, arrays, status = self._retry(x, order, indptr, arrays, status)
+            bad = status != K.OK
+        indices, values, grads, hess = arrays
+        if not bad.any():
+            return BasisFunctions(indptr, indices, values, grads, hess, None)
+        if self.outside == "error":
+            i = int(np.flatnonzero(bad)[0])
+            raise InputError(self._outside_message(i, x[i], int(bad.sum()), status[i]))
+        indptr, (indices, values, grads, hess) = compact_rows(
+            indptr, ~bad, indices, values, grads, hess)
+        return BasisFunctions(indptr, indices, values, grads, hess, bad)
+
+    def _retry(self, x, order, indptr, arrays, status):
+        """Solve failed points again with every node within R = max r_a, 2R, 4R, ...
+
+        With strongly varying h_a (clusters and gaps) the nodes whose own cut-off reaches x
+        may not surround it although x is inside the hull of all nodes. Points outside the
+        nodes' bounding box are outside the hull and are not retried; the radius grows until
+        it spans the bounding box (then every node takes part and failure is definitive).
+        """
+        lo, hi = self.nodes_.min(axis=0), self.nodes_.max(axis=0)
+        diag = float(np.linalg.norm(hi - lo))
+        in_box = np.all((x >= lo) & (x <= hi), axis=1)
+        radius = float(self.radius_.max())
+        while True:
+            rows = np.flatnonzero((status != K.OK) & in_box)
+            if len(rows) == 0:
+                break
+            sub_indptr, sub_arrays, sub_status = self._solve(
+                self.grid_.cells_within(x[rows], radius), order)
+            indptr, arrays = replace_rows(indptr, arrays, rows, sub_indptr, sub_arrays)
+            status[rows] = sub_status
+            if radius > diag:
+                break
+            radius *= 2.0
+        return indptr, arrays, status
+
+    def _solve(self, cells, order):
+        """Run the kernel on ``cells``: (indptr, [indices, values, grads, hess], status)."""
+        d = self.nodes_.shape[1]
+        indptr = cells.count()
+        nnz = int(indptr[-1])
+        indices = np.empty(nnz, dtype=np.int64)
+        values = np.empty(nnz)
+        grads = np.empty((nnz if order >= 1 else 0, d))
+        hess = np.empty((nnz if order >= 2 else 0, d, d))
+        status = np.empty(len(cells.points), dtype=np.int64)
+        K.lme_kernel(*cells.args(), self.beta_, indptr, float(self.newton_tol) * self.h_ref_,
+                     int(self.max_iter), order, indices, values, grads, hess, status)
+        arrays = [indices, values, grads if order >= 1 else None, hess if order >= 2 else None]
+        return indptr, arrays, status
+
+    @staticmethod
+    def _outside_message(i, xi, n_bad, code) -> str:
+        why = {K.NO_SUPPORT: "no d+1 nodes have their support there",
+               K.SINGULAR: "J(λ*) is numerically singular, so derivatives are undefined"}.get(
+                   int(code), "the dual problem min_λ log Z has no minimiser")
+        return (
+            f"LocalMaxEnt: evaluation point {i} at {np.array2string(xi, precision=6)} "
+            f"({n_bad} point(s) in all) lies outside the convex hull of the nodes, where LME "
+            f"basis functions do not exist ({why}), or so close to its boundary (within a "
+            "fraction of the node spacing, where the hull is spanned by distant nodes) that the "
+            "dual cannot be solved. Evaluate only inside the hull (test with "
+            "scipy.spatial.Delaunay(nodes).find_simplex(points) >= 0), add nodes around the "
+            "region, or pass outside='flag' to mark such points instead of raising."
+        )

@@ -1,0 +1,244 @@
+"""Nodal spacing, nodal locality and the support neighbours of evaluation points.
+
+Both approximants use Gaussian weights ``exp(-β_a |x - x_a|²)`` with a nodal locality
+``β_a = γ / h_a²`` (thesis Box 2, Rosolen et al. 2010: uniform aspect ratio γ = β_a h_a²) and
+cut them off where the weight drops below ``tol``, i.e. outside the radius
+``r_a = sqrt(-ln(tol) / β_a)``. This module computes ``h_a``, ``β_a``, ``r_a`` and, for many
+evaluation points, the CSR list of nodes whose support contains each point.
+
+Neighbour search: a uniform cell grid in which each node is registered in every cell its support
+touches (numba kernels) for d ≤ 4; a scipy cKDTree ball query (radius max r_a, then filtered
+by each node's own r_a) above.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numba as nb
+import numpy as np
+from scipy.spatial import cKDTree
+
+#: Largest dimension handled by the cell grid; above it the kd-tree path is used.
+GRID_MAX_DIM = 4
+
+
+def nodal_spacing(tree: cKDTree, nodes: np.ndarray, n_neighbors: int) -> np.ndarray:
+    """h_a: mean distance from node a to its ``n_neighbors`` nearest other nodes (length units).
+
+    On a Cartesian grid of spacing h with ``n_neighbors = 2d`` this is exactly h.
+    """
+    dist, _ = tree.query(nodes, k=n_neighbors + 1, workers=-1)
+    return dist[:, 1:].mean(axis=1)
+
+
+def locality(h: np.ndarray, gamma: float) -> np.ndarray:
+    """β_a = γ / h_a² (1/length²), thesis Box 2."""
+    return gamma / h**2
+
+
+def support_radius(beta: np.ndarray, tol: float) -> np.ndarray:
+    """r_a = sqrt(-ln(tol)/β_a): beyond it exp(-β_a r²) < tol and the node is dropped."""
+    return np.sqrt(-np.log(tol) / beta)
+
+
+class SupportGrid:
+    """Cell lists for repeated support-neighbour queries with per-node radii.
+
+    Every node is registered in all cells of a uniform grid that its support ball's bounding
+    box touches; a query then scans only the cell containing the point and keeps the nodes
+    with |x - x_a| < r_a. Cell side ≈ a fraction of the median radius (few candidates per
+    point even when the radii vary a lot). Dimensions above GRID_MAX_DIM use a kd-tree.
+    """
+
+    def __init__(self, nodes: np.ndarray, radii: np.ndarray):
+        self.nodes = np.ascontiguousarray(nodes, dtype=np.float64)
+        radii = np.ascontiguousarray(radii, dtype=np.float64)
+        self.radii2 = radii**2
+        n, d = self.nodes.shape
+        self.r_max = float(radii.max())
+        if d > GRID_MAX_DIM:
+            self.tree = cKDTree(self.nodes)
+            return
+        self.tree = None
+        lo = (self.nodes - radii[:, None]).min(axis=0)
+        extent = (self.nodes + radii[:, None]).max(axis=0) - lo
+        cell = float(np.median(radii)) * (0.25 * d)
+        max_cells = max(16 * n, 4096)
+        while np.prod(np.floor(extent / cell) + 1.0) > max_cells:
+            cell *= 1.25
+        shape = (np.floor(extent / cell) + 1).astype(np.int64)
+        strides = np.ones(d, dtype=np.int64)
+        for k in range(d - 2, -1, -1):
+            strides[k] = strides[k + 1] * shape[k + 1]
+        self.lo, self.cell, self.shape, self.strides = lo, cell, shape, strides
+        self.starts, self.entries = _register(self.nodes, radii, lo, cell, shape, strides)
+        # copies per entry so that a cell scan streams through contiguous memory
+        self.entry_x = np.ascontiguousarray(self.nodes[self.entries].T)
+        self.entry_r2 = self.radii2[self.entries]
+
+    def cells(self, points: np.ndarray) -> Cells:
+        """The candidate list of every point (see :class:`Cells`)."""
+        points = np.ascontiguousarray(points, dtype=np.float64)
+        m = len(points)
+        if self.tree is not None:  # one "cell" per point: its filtered kd-tree ball
+            indptr, indices = self._query_tree(points)
+            return Cells(points, np.arange(m, dtype=np.int64), indptr, indices,
+                         np.ascontiguousarray(self.nodes[indices].T), self.radii2[indices],
+                         np.arange(m, dtype=np.int64))
+        c = (points - self.lo) / self.cell
+        inside = np.all((c >= 0) & (c < self.shape), axis=1)
+        cid = np.where(inside, np.clip(np.nan_to_num(c), 0, self.shape - 1).astype(np.int64)
+                       @ self.strides, -1)
+        visit = np.argsort(cid, kind="stable").astype(np.int64)
+        return Cells(points, cid, self.starts, self.entries, self.entry_x, self.entry_r2, visit)
+
+    def cells_within(self, points: np.ndarray, radius: float) -> Cells:
+        """Candidate lists with one radius for all nodes (a wider net for retried points)."""
+        points = np.ascontiguousarray(points, dtype=np.float64)
+        m = len(points)
+        tree = self.tree if self.tree is not None else cKDTree(self.nodes)
+        lists = tree.query_ball_point(points, radius, workers=-1, return_sorted=True)
+        indptr, indices = _flatten(lists)
+        return Cells(points, np.arange(m, dtype=np.int64), indptr, indices,
+                     np.ascontiguousarray(self.nodes[indices].T),
+                     np.full(len(indices), np.inf), np.arange(m, dtype=np.int64))
+
+    def query(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """CSR (indptr (m+1,), indices (nnz,)) of the nodes a with |x_i - x_a| < r_a."""
+        cells = self.cells(points)
+        indptr = cells.count()
+        indices = np.empty(indptr[-1], dtype=np.int64)
+        _fill_kernel(*cells.args(), indptr, indices)
+        return indptr, indices
+
+    def _query_tree(self, points):
+        lists = self.tree.query_ball_point(points, self.r_max, workers=-1, return_sorted=True)
+        indptr, cand = _flatten(lists)
+        row = np.repeat(np.arange(len(points)), np.diff(indptr))
+        keep = ((points[row] - self.nodes[cand]) ** 2).sum(axis=1) < self.radii2[cand]
+        indptr = np.zeros(len(points) + 1, dtype=np.int64)
+        np.cumsum(np.bincount(row[keep], minlength=len(points)), out=indptr[1:])
+        return indptr, cand[keep]
+
+
+def _flatten(lists) -> tuple[np.ndarray, np.ndarray]:
+    """CSR (indptr, indices) of a sequence of index lists."""
+    counts = np.fromiter((len(li) for li in lists), dtype=np.int64, count=len(lists))
+    indptr = np.zeros(len(lists) + 1, dtype=np.int64)
+    np.cumsum(counts, out=indptr[1:])
+    indices = (np.concatenate([np.asarray(li, dtype=np.int64) for li in lists])
+               if indptr[-1] else np.empty(0, dtype=np.int64))
+    return indptr, indices
+
+
+@dataclass
+class Cells:
+    """Candidate support nodes of m points, for the numba kernels.
+
+    The candidates of point i are the entries ``starts[cell[i]] : starts[cell[i] + 1]``
+    (none if ``cell[i] < 0``); entry e is node ``entries[e]`` at ``entry_x[:, e]`` with
+    squared support radius ``entry_r2[e]``; a candidate is a support node when
+    |x_i - x_a|² < r_a². ``visit`` orders the points so that neighbours are processed together.
+    """
+
+    points: np.ndarray
+    cell: np.ndarray
+    starts: np.ndarray
+    entries: np.ndarray
+    entry_x: np.ndarray
+    entry_r2: np.ndarray
+    visit: np.ndarray
+
+    def args(self):
+        return (self.points, self.visit, self.cell, self.starts, self.entries, self.entry_x,
+                self.entry_r2)
+
+    def count(self) -> np.ndarray:
+        """indptr (m+1,) of the CSR layout of the support nodes of every point."""
+        counts = np.empty(len(self.points), dtype=np.int64)
+        _count_kernel(*self.args(), counts)
+        indptr = np.zeros(len(self.points) + 1, dtype=np.int64)
+        np.cumsum(counts, out=indptr[1:])
+        return indptr
+
+
+@nb.njit(cache=True)
+def _register(nodes, radii, lo, cell, shape, strides):
+    """CSR cell -> node lists, each node in every cell its support's bounding box touches."""
+    n, d = nodes.shape
+    n_cells = 1
+    for k in range(d):
+        n_cells *= shape[k]
+    counts = np.zeros(n_cells + 1, dtype=np.int64)
+    first = np.empty(d, dtype=np.int64)
+    last = np.empty(d, dtype=np.int64)
+    cur = np.empty(d, dtype=np.int64)
+    starts = np.zeros(n_cells + 1, dtype=np.int64)
+    entries = np.empty(0, dtype=np.int64)
+    for sweep in range(2):
+        if sweep == 1:
+            for c in range(n_cells):
+                starts[c + 1] = starts[c] + counts[c]
+            entries = np.empty(starts[n_cells], dtype=np.int64)
+            counts[:] = 0
+        for a in range(n):
+            for k in range(d):
+                first[k] = min(max(int(np.floor((nodes[a, k] - radii[a] - lo[k]) / cell)), 0),
+                               shape[k] - 1)
+                last[k] = min(max(int(np.floor((nodes[a, k] + radii[a] - lo[k]) / cell)), 0),
+                              shape[k] - 1)
+                cur[k] = first[k]
+            while True:
+                cid = 0
+                for k in range(d):
+                    cid += cur[k] * strides[k]
+                if sweep == 1:
+                    entries[starts[cid] + counts[cid]] = a
+                counts[cid] += 1
+                k = d - 1
+                while k >= 0 and cur[k] == last[k]:
+                    cur[k] = first[k]
+                    k -= 1
+                if k < 0:
+                    break
+                cur[k] += 1
+    return starts, entries
+
+
+@nb.njit(cache=True, inline="always")
+def scan(x, cid, starts, entries, entry_x, entry_r2, out, pos, write):
+    """Count (and write into out[pos:], if ``write``) the support nodes of x in cell ``cid``."""
+    if cid < 0:
+        return 0
+    d = x.shape[0]
+    count = 0
+    for q in range(starts[cid], starts[cid + 1]):
+        d2 = 0.0
+        for k in range(d):
+            t = x[k] - entry_x[k, q]
+            d2 += t * t
+        if d2 < entry_r2[q]:
+            if write:
+                out[pos + count] = q
+            count += 1
+    return count
+
+
+@nb.njit(parallel=True, cache=True)
+def _count_kernel(points, visit, cell, starts, entries, entry_x, entry_r2, counts):
+    dummy = np.empty(0, dtype=np.int64)
+    for ii in nb.prange(points.shape[0]):
+        i = visit[ii]
+        counts[i] = scan(points[i], cell[i], starts, entries, entry_x, entry_r2, dummy, 0,
+                         False)
+
+
+@nb.njit(parallel=True, cache=True)
+def _fill_kernel(points, visit, cell, starts, entries, entry_x, entry_r2, indptr, indices):
+    """indices[indptr[i]:indptr[i+1]] = the support nodes of point i."""
+    for ii in nb.prange(points.shape[0]):
+        i = visit[ii]
+        lo = indptr[i]
+        n = scan(points[i], cell[i], starts, entries, entry_x, entry_r2, indices, lo, True)
+        for q in range(lo, lo + n):
+            indices[q] = entries[indices[q]]

@@ -1,0 +1,123 @@
+"""Checks shared by the approximants: configuration values, node sets, evaluation points."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from pointatlas.errors import ConfigError, InputError
+from pointatlas.pointcloud import check_distinct, validate_points
+
+OUTSIDE_CHOICES = ("error", "flag")
+
+
+def check_positive(name: str, value, *, plugin: str) -> float:
+    if not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
+        raise ConfigError(
+            f"{plugin}: {name} = {value!r} is invalid; it must be a finite number > 0. "
+            f"Set e.g. {name}=0.8."
+        )
+    return float(value)
+
+
+def check_tol(value, *, plugin: str) -> float:
+    if not isinstance(value, (int, float)) or not 0.0 < value < 1.0:
+        raise ConfigError(
+            f"{plugin}: tol = {value!r} is invalid; it is the weight below which a node is "
+            "dropped and must lie in (0, 1). Use e.g. tol=1e-10."
+        )
+    return float(value)
+
+
+def check_outside(value, *, plugin: str) -> str:
+    if value not in OUTSIDE_CHOICES:
+        raise ConfigError(
+            f"{plugin}: outside = {value!r} is invalid; choose 'error' (raise on points "
+            "outside the domain) or 'flag' (mark them in BasisFunctions.outside)."
+        )
+    return value
+
+
+def spacing_neighbors(value, dim: int, n_nodes: int, *, plugin: str) -> int:
+    """The number of neighbours defining h_a: ``value`` or, if None, 2·d (exact on grids)."""
+    k = 2 * dim if value is None else value
+    if isinstance(k, bool) or not isinstance(k, int) or k < 1:
+        raise ConfigError(
+            f"{plugin}: n_spacing_neighbors = {value!r} is invalid; it must be an integer >= 1 "
+            "(or None for 2*d). Set e.g. n_spacing_neighbors=4."
+        )
+    if k >= n_nodes:
+        raise InputError(
+            f"{plugin}: n_spacing_neighbors = {k} needs more than {k} nodes, got {n_nodes}. "
+            "Give more nodes or lower n_spacing_neighbors."
+        )
+    return k
+
+
+def check_nodes(nodes, *, plugin: str, min_nodes: int | None = None) -> np.ndarray:
+    """Finite, distinct (n, d) nodes with n > d (or n >= ``min_nodes``)."""
+    X = validate_points(nodes, what=f"{plugin} nodes")
+    n, d = X.shape
+    need = d + 1 if min_nodes is None else min_nodes
+    if n < need:
+        raise InputError(
+            f"{plugin}: {n} node(s) in dimension {d}; need at least {need} (n > d) for the "
+            "basis functions to exist. Give more nodes."
+        )
+    check_distinct(X, what=f"{plugin} nodes")
+    return X
+
+
+def check_points(points, dim: int, *, plugin: str) -> np.ndarray:
+    X = validate_points(points, what=f"{plugin} evaluation points", min_points=0)
+    if X.shape[1] != dim:
+        raise InputError(
+            f"{plugin}: evaluation points have dimension {X.shape[1]} but the nodes have "
+            f"dimension {dim}; give points of shape (m, {dim})."
+        )
+    return X
+
+
+def check_order(order, max_order: int, *, plugin: str) -> int:
+    if isinstance(order, bool) or order not in tuple(range(max_order + 1)):
+        raise ConfigError(
+            f"{plugin}: order = {order!r} is invalid; use 0 (values), 1 (+ gradients)"
+            + (" or 2 (+ Hessians)." if max_order >= 2 else ".")
+        )
+    return int(order)
+
+
+def compact_rows(indptr, keep_row, *arrays):
+    """Drop the entries of rows where ``keep_row`` is False; returns new indptr and arrays."""
+    counts = np.diff(indptr) * keep_row
+    entry_keep = np.repeat(keep_row, np.diff(indptr))
+    new_indptr = np.zeros_like(indptr)
+    np.cumsum(counts, out=new_indptr[1:])
+    return new_indptr, [None if a is None else a[entry_keep] for a in arrays]
+
+
+def replace_rows(indptr, arrays, rows, sub_indptr, sub_arrays):
+    """CSR with the entries of ``rows`` replaced by the rows of (sub_indptr, sub_arrays)."""
+    m = len(indptr) - 1
+    counts = np.diff(indptr)
+    old_row = np.repeat(np.arange(m), counts)
+    counts[rows] = np.diff(sub_indptr)
+    new_indptr = np.zeros_like(indptr)
+    np.cumsum(counts, out=new_indptr[1:])
+    keep = np.ones(m, dtype=bool)
+    keep[rows] = False
+    kept = np.flatnonzero(keep[old_row])
+    dst_old = new_indptr[old_row[kept]] + (kept - indptr[old_row[kept]])
+    sub_row = np.repeat(np.arange(len(rows)), np.diff(sub_indptr))
+    j = np.arange(len(sub_row))
+    dst_sub = new_indptr[rows[sub_row]] + (j - sub_indptr[sub_row])
+    out = []
+    for a, b in zip(arrays, sub_arrays):
+        if a is None:
+            out.append(None)
+            continue
+        c = np.empty((new_indptr[-1],) + a.shape[1:], dtype=a.dtype)
+        c[dst_old] = a[kept]
+        c[dst_sub] = b
+        out.append(c)
+    return new_indptr, out

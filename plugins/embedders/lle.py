@@ -1,0 +1,85 @@
+"""Locally linear embedding (Roweis & Saul 2000; thesis §2.2), via scikit-learn.
+
+The embedding is scaled to unit covariance, (1/N) sum_a y_a y_a^T = I, the LLE constraint the
+thesis uses (sklearn's unit-norm eigenvectors times sqrt(N)); its metric is arbitrary, hence AIC.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar, Optional
+
+import numpy as np
+
+from pointatlas.errors import ConfigError
+
+from .base import EmbedderBase
+from .checks import check_float, check_int, check_points
+from .neighbor_graph import connected_neighbor_graph
+
+
+@dataclass
+class LLEConfig:
+    n_components: int = 2
+    n_neighbors: int = 12
+    reg: float = 1e-3
+    eigen_solver: str = "auto"
+    random_state: Optional[int] = 0
+    aic: bool = False
+    aic_neighbors: Optional[int] = None
+
+
+class LLEBase(EmbedderBase):
+    """sklearn ``LocallyLinearEmbedding`` with method ``_method``; checks and errors of our own."""
+
+    _method: ClassVar[str] = "standard"
+
+    def _min_neighbors(self, d: int) -> int:
+        return d + 1
+
+    def _embed(self, X) -> np.ndarray:
+        from sklearn.manifold import LocallyLinearEmbedding
+
+        k = check_int("n_neighbors", self.n_neighbors, low=1, fix="Typical values are 8-30.")
+        X = check_points(X, min_points=k + 1, reason=f" for n_neighbors={k}")
+        d = check_int("n_components", self.n_components, low=1)
+        if d >= X.shape[1]:
+            raise ConfigError(f"n_components={d} must be below the ambient dimension {X.shape[1]}; "
+                              "lower n_components.")
+        if k < self._min_neighbors(d):
+            raise ConfigError(
+                f"n_components={d} is too large for n_neighbors={k}: {self._method} LLE needs "
+                f"n_neighbors >= {self._min_neighbors(d)}. Raise n_neighbors or lower n_components."
+            )
+        check_float("reg", self.reg, low=0.0, low_open=True, fix="Typical value: 1e-3.")
+        if self.eigen_solver not in ("auto", "arpack", "dense"):
+            raise ConfigError(f"eigen_solver={self.eigen_solver!r}: use 'auto', 'arpack' or 'dense'.")
+        connected_neighbor_graph(X, k)
+        model = LocallyLinearEmbedding(
+            n_neighbors=k, n_components=d, reg=self.reg, eigen_solver=self.eigen_solver,
+            method=self._method, random_state=self.random_state, **self._extra())
+        # sklearn returns unit-norm eigenvectors; the thesis' LLE has unit covariance (§2.2)
+        Y = model.fit_transform(X) * np.sqrt(X.shape[0])
+        self.reconstruction_error_ = float(model.reconstruction_error_)
+        return Y
+
+    def _extra(self) -> dict:
+        return {}
+
+
+class LLE(LLEBase):
+    """Standard LLE, optionally followed by AIC."""
+
+    Config: ClassVar[type] = LLEConfig
+    description: ClassVar[str] = "Locally linear embedding (standard LLE, scikit-learn)."
+    _method: ClassVar[str] = "standard"
+
+    def __init__(self, *, n_components: int = 2, n_neighbors: int = 12, reg: float = 1e-3,
+                 eigen_solver: str = "auto", random_state: Optional[int] = 0, aic: bool = False,
+                 aic_neighbors: Optional[int] = None):
+        self.n_components = n_components
+        self.n_neighbors = n_neighbors
+        self.reg = reg
+        self.eigen_solver = eigen_solver
+        self.random_state = random_state
+        self.aic = aic
+        self.aic_neighbors = aic_neighbors

@@ -1,0 +1,38 @@
+import numpy as np
+import pytest
+
+import pointatlas
+from pointatlas.errors import ConfigError, InputError
+from pointatlas_embedders.isomap import Isomap
+from pointatlas_embedders.nlie import NLIE
+from pointatlas_embedders.quality import stress
+
+
+def test_nlie_beats_isomap_stress_on_quarter_sphere(quarter_sphere):
+    X = quarter_sphere
+    m = pointatlas.load_plugin("embedders", "nlie")(n_stress_neighbors=40, alpha=0.99).fit(X)
+    assert m.converged_ and m.embedding_.shape == (len(X), 2)
+    s_iso = stress(Isomap(n_neighbors=12).fit_transform(X), X, 12)
+    s_nlie = stress(m.embedding_, X, 12)
+    assert abs(s_nlie - m.stress_) < 1e-9 * s_nlie
+    assert s_nlie < 0.5 * s_iso
+
+
+def test_nlie_is_exact_on_a_plane():
+    rng = np.random.default_rng(0)
+    P = rng.random((150, 2)) * [3, 1]
+    X = np.c_[P, 0.3 * P[:, 0]]          # a tilted plane: an isometric embedding exists
+    # with k_G <= n_neighbors every stress pair is a graph edge, whose geodesic is Euclidean
+    m = NLIE(n_neighbors=12, n_stress_neighbors=10, tol=1e-10, lbfgs_max_iter=50, aic=True).fit(X)
+    assert m.stress_ < 1e-10 and m.objective_ < 1e-10
+
+
+def test_nlie_errors():
+    X = np.random.default_rng(0).random((55, 3))
+    with pytest.raises(ConfigError, match="alpha=0"):
+        NLIE(alpha=0).fit(X)
+    with pytest.raises(ConfigError, match="n_stress_neighbors=60"):
+        NLIE(n_stress_neighbors=60).fit(X)
+    two = np.r_[X, X + 10]
+    with pytest.raises(InputError, match="2 connected components"):
+        NLIE(n_neighbors=5, n_stress_neighbors=10).fit(two)

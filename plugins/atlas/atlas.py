@@ -1,0 +1,202 @@
+"""The atlas of a point-set manifold: patches, coarse partition of unity, charts, quadrature.
+
+Thesis §3 (L125–360) and Paper 2 §3: markers Q are partitioned into patches I_κ (METIS,
+recursive re-partition of unacceptable patches); a Shepard PU w_A over all markers is
+aggregated by patch, ψ_κ = Σ_{A∈I_κ} w_A; each patch gets a chart φ_κ on the embedded
+control points J_κ ⊃ {a : ψ_κ(P_a) > tol}; integrals are ∫_M f ≈ Σ_κ Σ_g w_g J_κ ψ_κ f.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Optional
+
+import numpy as np
+from scipy.sparse import csr_matrix
+from scipy.spatial import cKDTree
+
+from pointatlas.errors import ConfigError, InputError
+
+from . import differential_geometry as dg
+from .chart import Chart, ChartQuadrature, build_chart, chart_quadrature
+from .quadrature import simplex_rule
+from .partition import embedding_defects, is_connected, partition_markers, refine_partition
+
+
+@dataclass
+class AtlasSettings:
+    """Numerical parameters of the atlas (thesis Table I / BENCHMARKS.md)."""
+
+    n_patches: Optional[int] = None       # None: from markers_per_patch
+    markers_per_patch: int = 150
+    gamma_lme: float = 0.8
+    tol_lme: float = 1e-10
+    gamma_pu: float = 4.0
+    tol_pu: float = 1e-6
+    quadrature_order: int = 6
+    least_squares_fit: bool = True
+    chart_margin: float = 3.0             # extra control points within margin·h of supp ψ_κ
+    graph_neighbors: int = 10
+    max_stress: float = 0.02              # accept a patch's embedding below this stress ...
+    max_distortion: float = 2.5           # ... and this 95th-percentile singular-value ratio
+    #                                       of the triangles, with no folds
+    max_refinement_depth: int = 6
+
+    def check(self) -> None:
+        for name in ("gamma_lme", "tol_lme", "gamma_pu", "tol_pu", "chart_margin",
+                     "max_stress", "max_distortion"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and np.isfinite(v) and v > 0):
+                raise ConfigError(f"{name} = {v!r} is invalid; it must be a finite number > 0.")
+        if self.n_patches is not None and self.n_patches < 1:
+            raise ConfigError(f"n_patches = {self.n_patches!r} is invalid; use None or >= 1.")
+        if self.markers_per_patch < 8:
+            raise ConfigError(f"markers_per_patch = {self.markers_per_patch!r} is invalid; "
+                              "it must be >= 8 (a patch needs enough markers to be embedded).")
+
+
+@dataclass
+class QuadraturePoints:
+    """All quadrature points of the atlas (concatenated over charts)."""
+
+    chart: np.ndarray         # (m,) chart index
+    weights: np.ndarray       # (m,) w_g J ψ_κ
+    positions: np.ndarray     # (m, D)
+    tangents: np.ndarray      # (m, d, D)
+    geometry: dict = field(default_factory=dict)  # normal, H, K, metric ... (d=2, D=3)
+
+
+class Atlas:
+    """Charts glued by a coarse Shepard partition of unity; ``build`` then ``integrate``."""
+
+    def __init__(self, settings: AtlasSettings, make_embedder: Callable[[], object],
+                 make_lme: Callable[[], object], make_pu: Callable[[], object]):
+        self.settings = settings
+        self.make_embedder = make_embedder
+        self.make_lme = make_lme
+        self.make_pu = make_pu
+
+    # -- partition of unity ----------------------------------------------------------
+    def patch_pu(self, X: np.ndarray, labels: Optional[np.ndarray] = None) -> csr_matrix:
+        """ψ_κ at ambient points X as an (m, L) sparse matrix (rows sum to 1 where defined)."""
+        labels = self.labels_ if labels is None else labels
+        w = self.pu_.evaluate(X, order=0)
+        W = w.to_csr(self.markers_.shape[0])
+        L = int(labels.max()) + 1
+        agg = csr_matrix((np.ones(labels.size), (np.arange(labels.size), labels)),
+                         shape=(labels.size, L))
+        return (W @ agg).tocsr()
+
+    def _patch_values(self, X, members: np.ndarray) -> np.ndarray:
+        w = self.pu_.evaluate(X, order=0)
+        mask = np.zeros(self.markers_.shape[0], dtype=np.float64)
+        mask[members] = 1.0
+        rows = np.repeat(np.arange(w.n_points), np.diff(w.indptr))
+        return np.bincount(rows, weights=w.values * mask[w.indices], minlength=len(X))
+
+    # -- construction ----------------------------------------------------------------
+    def _control_set(self, members: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """J_κ and ψ_κ at its points: points where ψ_κ > tol_pu, grown by the margin."""
+        psi_all = np.asarray(self.W_points_[:, members].sum(axis=1)).ravel()
+        core = np.flatnonzero(psi_all > self.settings.tol_pu)
+        if core.size == 0:
+            core = np.unique(self.point_tree_.query(self.markers_[members], k=1)[1])
+        r = self.settings.chart_margin * self.h_points_
+        near = self.point_tree_.query_ball_point(self.points_[core], r)
+        J = np.unique(np.concatenate([core] + [np.asarray(n, dtype=np.int64) for n in near]))
+        return J, psi_all[J]
+
+    def _acceptable(self, members: np.ndarray) -> bool:
+        s = self.settings
+        if not is_connected(self.adjacency_, members):
+            return False
+        J, _ = self._control_set(members)
+        if J.size < 10:
+            return True
+        xi = np.asarray(self.make_embedder().fit_transform(self.points_[J]))
+        defects = embedding_defects(self.points_[J], xi)
+        self.defects_[tuple(members[:3])] = defects
+        return (defects["flip_fraction"] == 0.0 and defects["stress"] < s.max_stress
+                and defects["distortion"] < s.max_distortion)
+
+    def partition(self, points: np.ndarray, markers: Optional[np.ndarray] = None) -> np.ndarray:
+        """Partition the markers (default: the points) and fit the PU. Returns labels (M,)."""
+        s = self.settings
+        s.check()
+        P = np.asarray(points, dtype=np.float64)
+        Q = P if markers is None else np.asarray(markers, dtype=np.float64)
+        if P.ndim != 2 or Q.ndim != 2 or Q.shape[1] != P.shape[1]:
+            raise InputError(f"points {P.shape} and markers {Q.shape} must be (n, D) arrays "
+                             "with the same D.")
+        self.points_, self.markers_ = P, Q
+        self.point_tree_ = cKDTree(P)
+        self.h_points_ = float(np.median(self.point_tree_.query(P, k=2)[0][:, 1]))
+        self.pu_ = self.make_pu().fit(Q)
+        self.W_points_ = self.pu_.evaluate(P, order=0).to_csr(Q.shape[0]).tocsc()
+        n_parts = s.n_patches or max(1, int(round(Q.shape[0] / s.markers_per_patch)))
+        labels, self.adjacency_ = partition_markers(Q, n_parts, s.graph_neighbors)
+        self.initial_n_patches_ = int(labels.max()) + 1
+        self.defects_ = {}
+        self.labels_, self.accepted_ = refine_partition(
+            labels, self.adjacency_, self._acceptable, max_depth=s.max_refinement_depth)
+        return self.labels_
+
+    def build_charts(self, progress=lambda it, **kw: it) -> list[Chart]:
+        """One chart per patch (after :meth:`partition`)."""
+        s = self.settings
+        self.charts_, self.support_ = [], []
+        L = int(self.labels_.max()) + 1
+        for k in progress(range(L), total=L, desc="charts"):
+            members = np.flatnonzero(self.labels_ == k)
+            J, psi = self._control_set(members)
+            self.charts_.append(build_chart(self.points_, J, self.make_embedder(), self.make_lme,
+                                            s.least_squares_fit))
+            self.support_.append(psi)
+        return self.charts_
+
+    def build_quadrature(self, progress=lambda it, **kw: it, need_second: bool = True
+                         ) -> list[ChartQuadrature]:
+        s = self.settings
+        self.quadrature_ = []
+        for k in progress(range(len(self.charts_)), total=len(self.charts_), desc="quadrature"):
+            members = np.flatnonzero(self.labels_ == k)
+            self.quadrature_.append(chart_quadrature(
+                self.charts_[k], self.support_[k], lambda X, m=members: self._patch_values(X, m),
+                s.quadrature_order, s.tol_pu, need_second))
+        return self.quadrature_
+
+    def build(self, points, markers=None, progress=lambda it, **kw: it) -> "Atlas":
+        self.partition(points, markers)
+        self.build_charts(progress)
+        self.build_quadrature(progress)
+        return self
+
+    # -- use ---------------------------------------------------------------------------
+    def quadrature_points(self) -> QuadraturePoints:
+        q = self.quadrature_
+        T = np.concatenate([c.tangents for c in q])
+        S = None if q[0].second is None else np.concatenate([c.second for c in q])
+        return QuadraturePoints(
+            chart=np.concatenate([np.full(len(c.weights), k) for k, c in enumerate(q)]),
+            weights=np.concatenate([c.weights for c in q]),
+            positions=np.concatenate([c.positions for c in q]),
+            tangents=T, geometry=dg.surface_geometry(T, S))
+
+    def integrate(self, f: Callable[[QuadraturePoints], np.ndarray], per_chart: bool = False):
+        """∫_M f dM ≈ Σ_κ Σ_g w_g J_κ ψ_κ f (thesis §3.4); f gets a :class:`QuadraturePoints`.
+
+        With per_chart=True returns the (L,) chart contributions ∫_M ψ_κ f dM.
+        """
+        qp = self.quadrature_points()
+        vals = np.asarray(f(qp), dtype=np.float64) * qp.weights
+        parts = np.bincount(qp.chart, weights=vals, minlength=len(self.quadrature_))
+        return parts if per_chart else float(parts.sum())
+
+    def redundancy(self) -> float:
+        """Quadrature redundancy (Paper 2 Fig. 1): Gauss points used over all charts, divided
+        by the Gauss points one chart-free triangulation of the points would need
+        (2 N triangles for a closed surface of N points, times the rule size)."""
+        n_used = sum(len(c.weights) for c in self.quadrature_)
+        rule = simplex_rule(self.charts_[0].xi_nodes.shape[1],
+                            self.settings.quadrature_order).n_points
+        n_tri = 2 * self.points_.shape[0] if self.points_.shape[1] == 3 else self.points_.shape[0]
+        return n_used / (n_tri * rule)

@@ -1,0 +1,157 @@
+"""Partition of the geometric markers Q into patches (thesis §3, L125–200; Paper 2 §3.1).
+
+The markers are split into L groups I_κ by METIS on a symmetrised k-nearest-neighbour graph.
+A patch whose chart is not acceptable (disconnected, folded or too distorted when embedded
+in R^d) is re-partitioned recursively into two (thesis: "we proceed by recursively
+re-partitioning such patches"). The acceptance test is supplied by the caller (the atlas
+builds the chart and measures it); :func:`embedding_defects` gives the measures.
+"""
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+from scipy.sparse import coo_matrix, csr_matrix
+from scipy.sparse.csgraph import connected_components
+from scipy.spatial import Delaunay, cKDTree
+
+from pointatlas.errors import ConfigError, InputError
+
+
+def knn_graph(points: np.ndarray, n_neighbors: int) -> csr_matrix:
+    """Symmetrised k-NN adjacency (unweighted, no self loops) of the (n, D) points."""
+    n = points.shape[0]
+    k = min(int(n_neighbors), n - 1)
+    if k < 1:
+        raise InputError(f"a neighbour graph needs at least 2 points; got {n}.")
+    _, nb = cKDTree(points).query(points, k=k + 1)
+    rows = np.repeat(np.arange(n), k)
+    cols = nb[:, 1:].ravel()
+    A = coo_matrix((np.ones(rows.size), (rows, cols)), shape=(n, n)).tocsr()
+    A = ((A + A.T) > 0).astype(np.float64)
+    A.setdiag(0)
+    A.eliminate_zeros()
+    return A.tocsr()
+
+
+def metis_parts(adjacency: csr_matrix, n_parts: int) -> np.ndarray:
+    """Labels (n,) of a METIS k-way partition of the graph into n_parts parts."""
+    import pymetis
+
+    n = adjacency.shape[0]
+    if n_parts <= 1 or n <= n_parts:
+        return np.zeros(n, dtype=np.int64) if n_parts <= 1 else np.arange(n) % n_parts
+    A = adjacency.tocsr()
+    A.sort_indices()
+    _, parts = pymetis.part_graph(
+        int(n_parts), adjacency=pymetis.CSRAdjacency(A.indptr.astype(np.int64),
+                                                     A.indices.astype(np.int64)))
+    return np.asarray(parts, dtype=np.int64)
+
+
+def split_disconnected(adjacency: csr_matrix, labels: np.ndarray) -> np.ndarray:
+    """Relabel so that every part induces a connected subgraph (components become parts)."""
+    out = np.empty_like(labels)
+    next_label = 0
+    for lab in np.unique(labels):
+        idx = np.flatnonzero(labels == lab)
+        n_comp, comp = connected_components(adjacency[idx][:, idx], directed=False)
+        out[idx] = next_label + comp
+        next_label += n_comp
+    return out
+
+
+def is_connected(adjacency: csr_matrix, indices: np.ndarray) -> bool:
+    n_comp, _ = connected_components(adjacency[indices][:, indices], directed=False)
+    return n_comp == 1
+
+
+def partition_markers(markers: np.ndarray, n_parts: int, n_neighbors: int = 10
+                      ) -> tuple[np.ndarray, csr_matrix]:
+    """METIS partition of the markers into (about) n_parts connected patches.
+
+    Returns the labels (M,) in 0..L-1 and the k-NN adjacency used.
+    """
+    if isinstance(n_parts, bool) or not isinstance(n_parts, (int, np.integer)) or n_parts < 1:
+        raise ConfigError(f"n_patches = {n_parts!r} is invalid; it must be an integer >= 1.")
+    A = knn_graph(markers, n_neighbors)
+    labels = split_disconnected(A, metis_parts(A, int(n_parts)))
+    return labels, A
+
+
+def refine_partition(labels: np.ndarray, adjacency: csr_matrix,
+                     acceptable: Callable[[np.ndarray], bool], max_depth: int = 6,
+                     min_size: int = 8) -> tuple[np.ndarray, np.ndarray]:
+    """Recursively bisect (METIS) every patch for which ``acceptable(marker_indices)`` fails.
+
+    A patch with fewer than 2·min_size markers or at depth max_depth is kept as it is.
+    Returns new labels 0..L'-1 and, per final patch, whether it passed the test.
+    """
+    queue = [(np.flatnonzero(labels == lab), 0) for lab in np.unique(labels)]
+    final: list[tuple[np.ndarray, bool]] = []
+    while queue:
+        idx, depth = queue.pop()
+        ok = acceptable(idx)
+        if ok or depth >= max_depth or idx.size < 2 * min_size:
+            final.append((idx, ok))
+            continue
+        sub = adjacency[idx][:, idx]
+        halves = split_disconnected(sub, metis_parts(sub, 2))
+        for lab in np.unique(halves):
+            queue.append((idx[halves == lab], depth + 1))
+    out = np.empty_like(labels)
+    final.sort(key=lambda item: item[0].min())
+    for k, (idx, _) in enumerate(final):
+        out[idx] = k
+    return out, np.array([ok for _, ok in final], dtype=bool)
+
+
+def embedding_defects(points: np.ndarray, xi: np.ndarray, n_neighbors: int = 8
+                      ) -> dict[str, float]:
+    """How far an embedding ξ (n, d=2) of points (n, D) is from a good chart.
+
+    - ``stress``: Σ_edges (|ξ_a − ξ_b| − |P_a − P_b|)² / Σ_edges |P_a − P_b|² over the k-NN
+      edges (a normalised version of the stress E_S of thesis Appendix E.1);
+    - ``flip_fraction``: fraction of pairs of adjacent Delaunay triangles of ξ whose images
+      in R^3 (vertices ordered counter-clockwise in ξ) have opposite normals: a fold;
+    - ``max_distortion`` / ``distortion``: largest / 95th-percentile ratio of singular values of
+      the affine map ξ → P over the non-sliver triangles (edges < 3 median k-NN distances).
+    """
+    A = knn_graph(points, n_neighbors).tocoo()
+    dx = np.linalg.norm(points[A.row] - points[A.col], axis=1)
+    dxi = np.linalg.norm(xi[A.row] - xi[A.col], axis=1)
+    out = {"stress": float(np.sum((dxi - dx) ** 2) / np.sum(dx**2))}
+    if xi.shape[1] != 2 or points.shape[1] != 3 or len(xi) < 4:
+        r = float(np.max(dxi / dx) / np.min(dxi / dx))
+        out.update(flip_fraction=0.0, max_distortion=r, distortion=r)
+        return out
+    tri = Delaunay(xi)
+    S = tri.simplices.copy()
+    e1, e2 = xi[S[:, 1]] - xi[S[:, 0]], xi[S[:, 2]] - xi[S[:, 0]]
+    neg = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0] < 0
+    S[neg, 1], S[neg, 2] = S[neg, 2], S[neg, 1].copy()
+    P0, P1, P2 = points[S[:, 0]], points[S[:, 1]], points[S[:, 2]]
+    edge = np.max(np.stack([np.linalg.norm(P1 - P0, axis=1), np.linalg.norm(P2 - P0, axis=1),
+                            np.linalg.norm(P2 - P1, axis=1)]), axis=0)
+    # slivers (hull-boundary or near-degenerate triangles in ξ) have unreliable normals
+    l2 = (np.sum(e1**2, 1) + np.sum(e2**2, 1) + np.sum((e2 - e1) ** 2, 1))
+    shape_quality = 4.0 * np.sqrt(3.0) * 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]) / l2
+    good = (edge < 3.0 * np.median(dx)) & (shape_quality > 0.2)
+    normal = np.cross(P1 - P0, P2 - P0)
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True) + 1e-300
+    nbr = tri.neighbors
+    pairs = [(t, s) for t in np.flatnonzero(good) for s in nbr[t] if s > t and good[s]]
+    if pairs:
+        pa = np.array(pairs)
+        out["flip_fraction"] = float(np.mean(np.sum(normal[pa[:, 0]] * normal[pa[:, 1]], 1) < 0))
+    else:
+        out["flip_fraction"] = 0.0
+    # affine map ξ → P on each good triangle: P_e = F ξ_e with F (3, 2)
+    E_xi = np.stack([xi[S[:, 1]] - xi[S[:, 0]], xi[S[:, 2]] - xi[S[:, 0]]], axis=2)  # (t,2,2)
+    E_P = np.stack([P1 - P0, P2 - P0], axis=2)  # (t,3,2)
+    F = E_P[good] @ np.linalg.inv(E_xi[good])
+    sv = np.linalg.svd(F, compute_uv=False)
+    ratio = sv[:, 0] / np.maximum(sv[:, -1], 1e-300) if len(sv) else np.ones(1)
+    out["max_distortion"] = float(np.max(ratio))
+    out["distortion"] = float(np.quantile(ratio, 0.95))
+    return out

@@ -50,9 +50,9 @@ def explain(exc: Exception, overrides: list[str]) -> str:
         key, _, value = override.lstrip("+~").partition("=")
         if key in FAMILIES.values() and value and value != "null":
             load_plugin(key, value)  # unknown: lists installed names; broken: says why
-        if key == "experiment" and "experiment/" in text:
-            from .config import experiments
+        from .config import experiments
 
+        if key == "experiment" and value not in experiments():
             return (f"No experiment named {value!r}. Available: {', '.join(sorted(experiments()))}. "
                     "Fix the name (experiments/ holds the definitions).")
     missing = re.search(r"Could not find '(\w+)/([\w.-]+)'", text)

@@ -76,22 +76,27 @@ class PointFile:
         path: str = "???"
         intrinsic_dim: Optional[int] = None
         name: Optional[str] = None
+        #: keep at most this many points (a seeded random subset); None keeps all. Lets an
+        #: experiment's resolution key (source.n_points) apply to files too.
+        n_points: Optional[int] = None
 
     description: ClassVar[str] = "Point set read from a file (.npz, .ply, .vtk/.vtp, .csv/.txt)."
     parameter_constraints: ClassVar[dict[str, str]] = {
         "path": f"existing file with suffix in {SUFFIXES}",
         "intrinsic_dim": "None or an integer in [1, ambient dimension]",
         "name": "None (use the file stem) or a label",
+        "n_points": "None or an integer >= 1 (at most this many points are kept)",
     }
 
     def __init__(self, *, path: str = "???", intrinsic_dim: Optional[int] = None,
-                 name: Optional[str] = None):
+                 name: Optional[str] = None, n_points: Optional[int] = None):
         self.path = path
         self.intrinsic_dim = intrinsic_dim
         self.name = name
+        self.n_points = n_points
 
     def load(self, rng: np.random.Generator | None = None) -> PointCloud:
-        """Read the file (``rng`` is unused: reading is deterministic)."""
+        """Read the file; ``rng`` chooses the subset when ``n_points`` is below the file's count."""
         if not isinstance(self.path, (str, Path)) or str(self.path) in ("", "???"):
             raise ConfigError("path is missing: the 'file' source needs path=<file with points>, "
                               "e.g. source.path=data/points.npz on the command line.")
@@ -118,5 +123,12 @@ class PointFile:
         if d is not None and not (isinstance(d, (int, np.integer)) and 1 <= d <= points.shape[1]):
             raise ConfigError(f"intrinsic_dim={d!r} is invalid: must be None or an integer in "
                               f"[1, {points.shape[1]}] (the ambient dimension of {path}).")
+        n = self.n_points
+        if n is not None:
+            if not isinstance(n, (int, np.integer)) or n < 1:
+                raise ConfigError(f"n_points={n!r} is invalid: must be None or an integer >= 1.")
+            if n < len(points):
+                rng = rng if rng is not None else np.random.default_rng(0)
+                points = points[np.sort(rng.choice(len(points), size=n, replace=False))]
         return PointCloud(points=points, markers=markers, intrinsic_dim=d,
                           name=self.name or path.stem)

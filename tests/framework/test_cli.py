@@ -19,7 +19,7 @@ def catalog_rows(root):
 @pytest.fixture(scope="module")
 def default_run(tmp_path_factory, run_cli):
     cwd = tmp_path_factory.mktemp("default")
-    proc = run_cli("pointatlas", "source.n_points=1000", "seed=3", f"hydra.run.dir={cwd}/run", cwd=cwd)
+    proc = run_cli("pointatlas", "experiment=swiss_roll_isomap", "source.n_points=1000", "seed=3", f"hydra.run.dir={cwd}/run", cwd=cwd)
     return cwd, proc
 
 
@@ -30,7 +30,7 @@ def test_default_run_writes_results_with_provenance(default_run):
     for attr in REQUIRED_ATTRS:
         assert attr in ds.attrs, attr
     assert ds.attrs["status"] == "completed" and ds.attrs["seed"] == 3
-    assert json.loads(ds.attrs["overrides"])[0] == "source.n_points=1000"
+    assert json.loads(ds.attrs["overrides"])[:2] == ["experiment=swiss_roll_isomap", "source.n_points=1000"]
     assert "n_points: 1000" in ds.attrs["config"]
     assert "embedder=isomap" in ds.attrs["source"]
     assert ds.sizes["point"] == 1000 and ds.sizes["latent"] == 2
@@ -49,7 +49,7 @@ def test_default_run_is_in_the_catalog(default_run):
 
 def test_same_seed_same_results(default_run, tmp_path, run_cli):
     cwd, _ = default_run
-    proc = run_cli("pointatlas", "source.n_points=1000", "seed=3", f"hydra.run.dir={tmp_path}/run", cwd=tmp_path)
+    proc = run_cli("pointatlas", "experiment=swiss_roll_isomap", "source.n_points=1000", "seed=3", f"hydra.run.dir={tmp_path}/run", cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
     a, b = pointatlas.open_run(cwd / "run"), pointatlas.open_run(tmp_path / "run")
     np.testing.assert_array_equal(a["points"].values, b["points"].values)
@@ -86,7 +86,7 @@ def test_missing_input_file_is_a_clear_failure_recorded_in_catalog(tmp_path, run
 
 def test_third_party_plugin_runs_by_name(tmp_path, run_cli):
     pytest.importorskip("pointatlas_spectral", reason="examples/third_party_plugin not installed")
-    proc = run_cli("pointatlas", "embedder=spectral", "embedder.n_neighbors=12",
+    proc = run_cli("pointatlas", "experiment=swiss_roll_isomap", "embedder=spectral", "embedder.n_neighbors=12",
                    "source.n_points=500", f"hydra.run.dir={tmp_path}/run", cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
     ds = pointatlas.open_run(tmp_path / "run")
@@ -100,3 +100,22 @@ def test_help_lists_groups(tmp_path, run_cli):
     assert proc.returncode == 0
     for group in ("source", "embedder", "study", "experiment", "sweep"):
         assert f"{group}:" in proc.stdout
+
+
+def test_experiment_runs_unchanged_on_a_point_file(tmp_path, run_cli):
+    X = np.random.default_rng(0).normal(size=(700, 3))
+    np.savez(tmp_path / "cloud.npz", points=X / np.linalg.norm(X, axis=1, keepdims=True))
+    proc = run_cli("pointatlas", "experiment=swiss_roll_isomap", "source=file",
+                   f"source.path={tmp_path}/cloud.npz",
+                   f"hydra.run.dir={tmp_path}/run", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert pointatlas.open_run(tmp_path / "run").sizes["point"] == 700
+
+
+def test_no_arguments_runs_the_sphere_willmore_default(tmp_path, run_cli):
+    proc = run_cli("pointatlas", "source.n_points=1500", f"hydra.run.dir={tmp_path}/run", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    ds = pointatlas.open_run(tmp_path / "run")
+    assert ds.attrs["experiment"] == "sphere_willmore"
+    assert float(ds["relative_error_area"]) < 1e-3
+    assert float(ds["relative_error_willmore_energy"]) < 1e-2

@@ -11,7 +11,7 @@ import pointatlas
 def test_two_job_sweep_is_cataloged(tmp_path, launcher, run_cli):
     if launcher == "submitit_local":
         pytest.importorskip("hydra_plugins.hydra_submitit_launcher")
-    proc = run_cli("pointatlas", "--multirun", "source.n_points=300,400", "embedder=pca",
+    proc = run_cli("pointatlas", "--multirun", "experiment=swiss_roll_isomap", "source.n_points=300,400", "embedder=pca",
                    f"hydra/launcher={launcher}", f"hydra.sweep.dir={tmp_path}/sweep",
                    cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr[-3000:]

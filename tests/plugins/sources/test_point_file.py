@@ -89,3 +89,15 @@ def test_bad_intrinsic_dim(tmp_path, cloud):
     np.savez(tmp_path / "a.npz", points=cloud)
     with pytest.raises(ConfigError, match="intrinsic_dim=5"):
         PointFile(path=str(tmp_path / "a.npz"), intrinsic_dim=5).load(None)
+
+
+def test_n_points_keeps_a_seeded_subset(tmp_path):
+    import numpy as np
+    from pointatlas_sources.point_file import PointFile
+
+    X = np.random.default_rng(0).random((100, 3))
+    np.savez(tmp_path / "p.npz", points=X)
+    a = PointFile(path=str(tmp_path / "p.npz"), n_points=40).load(np.random.default_rng(1))
+    b = PointFile(path=str(tmp_path / "p.npz"), n_points=40).load(np.random.default_rng(1))
+    assert a.points.shape == (40, 3) and np.array_equal(a.points, b.points)
+    assert PointFile(path=str(tmp_path / "p.npz"), n_points=500).load(np.random.default_rng(1)).n_points == 100

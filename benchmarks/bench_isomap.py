@@ -1,7 +1,7 @@
 """Benchmark: pointatlas Isomap vs scikit-learn Isomap on a swiss roll (numpy-generated).
 
 Prints a table (N, time ours, time sklearn, max |difference| after sign alignment, relative to
-max |Y|) and writes ``bench_isomap.nc`` next to this script (or to argv[1]).
+max |Y|) and writes ``results/bench_isomap.nc`` beside this script (or to argv[1]).
 Usage: python benchmarks/bench_isomap.py [out.nc] [N ...]
 """
 from __future__ import annotations
@@ -26,7 +26,7 @@ def main(argv: list[str]) -> None:
 
     from pointatlas_embedders.isomap import Isomap
 
-    out = Path(argv[0]) if argv and argv[0].endswith(".nc") else Path(__file__).with_name("bench_isomap.nc")
+    out = Path(argv[0]) if argv and argv[0].endswith(".nc") else Path(__file__).parent / "results" / "bench_isomap.nc"
     sizes = [int(a) for a in argv if a.isdigit()] or [2000, 5000, 10000]
     k, d = 12, 2
     Isomap(n_neighbors=k, n_components=d).fit_transform(swiss_roll(300))  # warm-up (numba, imports)

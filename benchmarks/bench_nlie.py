@@ -2,7 +2,7 @@
 
 Each size runs in a fresh subprocess so that its peak RSS (``ru_maxrss``) is its own. Prints a
 table (N, seconds, peak RSS MiB, L-BFGS / Newton / CG iterations, stress per pair, converged)
-and writes ``bench_nlie.nc`` next to this script (or to argv[1]).
+and writes ``results/bench_nlie.nc`` beside this script (or to argv[1]).
 Usage: python benchmarks/bench_nlie.py [out.nc] [N ...]
 """
 from __future__ import annotations
@@ -48,7 +48,7 @@ def main(argv: list[str]) -> None:
         return
     import xarray as xr
 
-    out = Path(argv[0]) if argv and argv[0].endswith(".nc") else Path(__file__).with_name("bench_nlie.nc")
+    out = Path(argv[0]) if argv and argv[0].endswith(".nc") else Path(__file__).parent / "results" / "bench_nlie.nc"
     sizes = [int(a) for a in argv if a.isdigit()] or [5000, 10000, 20000]
     rows = []
     print(f"{'N':>7} {'time [s]':>9} {'peak RSS [MiB]':>15} {'L-BFGS':>7} {'Newton':>7} {'CG':>6} "

@@ -66,6 +66,12 @@ def explain(exc: Exception, overrides: list[str]) -> str:
         where = f"of {family} " if family else ""
         hint = f" Valid keys {where}are: {', '.join(valid)}." if valid else ""
         return f"Unknown config key {key!r}.{hint} Fix the spelling of the override."
+    if "ConfigKeyError raised while composing" in text:
+        where = re.search(r"In '([^']+)'", text)
+        return (f"{text.strip().splitlines()[0]} {text.strip().splitlines()[1].strip()}: "
+                f"{where.group(1) if where else 'the experiment'} sets a key that the plugin chosen "
+                "on the command line does not have. Pick an experiment made for that plugin, or add "
+                "~experiment (drop the default experiment) to start from the bare defaults.")
     cause = exc.__cause__
     while cause is not None and cause.__cause__ is not None and str(cause) == text:
         cause = cause.__cause__

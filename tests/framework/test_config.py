@@ -21,7 +21,9 @@ def choices():
 @pytest.mark.parametrize("group,name", choices())
 def test_every_config_group_composes(group, name):
     with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
-        cfg = compose("config", overrides=[f"{group}={name}"], return_hydra_config=True)
+        # ~experiment: the default experiment sets keys of its own plugins
+        extra = [] if group == "experiment" else ["~experiment"]
+        cfg = compose("config", overrides=[f"{group}={name}", *extra], return_hydra_config=True)
     assert cfg.hydra.runtime.choices[group] == name
 
 

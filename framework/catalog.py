@@ -21,15 +21,14 @@ from __future__ import annotations
 import json
 import math
 import os
-import random
 import sqlite3
-import time
 from dataclasses import dataclass, field
 from datetime import datetime
 from pathlib import Path
 from typing import Callable, Iterable, TypeVar
 
 from .errors import ConfigError, InputError, SchemaError
+from .sqlite_access import connect, immediate_transaction, read, retry, write
 from .run_filters import (  # noqa: F401 - re-exported
     METRIC_SYNTAX, WHERE_SYNTAX, MetricFilter, WhereFilter, overrides_as_dict, parse_metric,
     parse_where,
@@ -43,8 +42,6 @@ CATALOG_FILENAME = "catalog.sqlite"
 STATUSES = ("running", "completed", "failed")
 MISSING = "missing"
 
-_BUSY_TIMEOUT_S = 60.0
-_RETRY_DEADLINE_S = 180.0
 
 _SCHEMA = """
 CREATE TABLE IF NOT EXISTS schema_version (version INTEGER NOT NULL);
@@ -126,7 +123,7 @@ class Catalog:
     def __init__(self, path: str | Path):
         self.path = Path(path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        self._retry(self._init_schema)
+        retry(self._init_schema)
 
     def __repr__(self) -> str:
         return f"Catalog({str(self.path)!r})"
@@ -244,84 +241,36 @@ class Catalog:
 
     # -- plumbing --------------------------------------------------------------------------
 
-    def _connect(self) -> sqlite3.Connection:
-        conn = sqlite3.connect(str(self.path), timeout=_BUSY_TIMEOUT_S, isolation_level=None)
-        conn.row_factory = sqlite3.Row
-        conn.execute(f"PRAGMA busy_timeout={int(_BUSY_TIMEOUT_S * 1000)}")
-        conn.execute("PRAGMA foreign_keys=ON")
-        conn.execute("PRAGMA synchronous=NORMAL")  # safe with WAL; may drop the last commit on power loss
-        return conn
-
     def _init_schema(self) -> None:
-        conn = self._connect()
+        conn = connect(self.path)
         try:
             if _current_version(conn) == SCHEMA_VERSION:
                 return  # ready: no write needed (works on a read-only copy too)
             if conn.execute("PRAGMA journal_mode").fetchone()[0].lower() != "wal":
                 conn.execute("PRAGMA journal_mode=WAL")
-            conn.execute("BEGIN IMMEDIATE")
-            for statement in filter(str.strip, _SCHEMA.split(";")):
-                conn.execute(statement)
-            row = conn.execute("SELECT MAX(version) FROM schema_version").fetchone()
-            version = row[0]
-            if version is None:
-                conn.execute("INSERT INTO schema_version (version) VALUES (?)", (SCHEMA_VERSION,))
-            elif version > SCHEMA_VERSION:
-                conn.execute("ROLLBACK")
-                raise SchemaError(f"catalog {self.path} has schema version {version}, newer than "
-                                  f"the {SCHEMA_VERSION} this pointatlas reads: upgrade pointatlas")
-            else:
-                while version < SCHEMA_VERSION:
-                    _MIGRATIONS[version](conn)
-                    version += 1
-                conn.execute("UPDATE schema_version SET version=?", (SCHEMA_VERSION,))
-            conn.execute("COMMIT")
-        except BaseException:
-            if conn.in_transaction:
-                conn.execute("ROLLBACK")
-            raise
+            with immediate_transaction(conn):
+                for statement in filter(str.strip, _SCHEMA.split(";")):
+                    conn.execute(statement)
+                version = conn.execute("SELECT MAX(version) FROM schema_version").fetchone()[0]
+                if version is None:
+                    conn.execute("INSERT INTO schema_version (version) VALUES (?)", (SCHEMA_VERSION,))
+                elif version > SCHEMA_VERSION:
+                    raise SchemaError(f"catalog {self.path} has schema version {version}, newer "
+                                      f"than the {SCHEMA_VERSION} this pointatlas reads: upgrade "
+                                      "pointatlas")
+                else:
+                    while version < SCHEMA_VERSION:
+                        _MIGRATIONS[version](conn)
+                        version += 1
+                    conn.execute("UPDATE schema_version SET version=?", (SCHEMA_VERSION,))
         finally:
             conn.close()
 
     def _write(self, operation: Callable[[sqlite3.Connection], None]) -> None:
-        def attempt() -> None:
-            conn = self._connect()
-            try:
-                conn.execute("BEGIN IMMEDIATE")
-                operation(conn)
-                conn.execute("COMMIT")
-            except BaseException:
-                if conn.in_transaction:
-                    conn.execute("ROLLBACK")
-                raise
-            finally:
-                conn.close()
-
-        self._retry(attempt)
+        write(self.path, operation)
 
     def _read(self, operation: Callable[[sqlite3.Connection], T]) -> T:
-        def attempt() -> T:
-            conn = self._connect()
-            try:
-                return operation(conn)
-            finally:
-                conn.close()
-
-        return self._retry(attempt)
-
-    @staticmethod
-    def _retry(attempt: Callable[[], T]) -> T:
-        deadline = time.monotonic() + _RETRY_DEADLINE_S
-        delay = 0.01
-        while True:
-            try:
-                return attempt()
-            except sqlite3.OperationalError as exc:
-                message = str(exc).lower()
-                if ("locked" not in message and "busy" not in message) or time.monotonic() > deadline:
-                    raise
-            time.sleep(delay * (0.5 + random.random()))
-            delay = min(delay * 2, 1.0)
+        return read(self.path, operation)
 
 
 # ----------------------------------------------------------------------------- helpers

@@ -14,44 +14,13 @@ import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.spatial import cKDTree
 
-from pointatlas.errors import ConfigError, InputError
+from pointatlas.errors import InputError
 
 from . import differential_geometry as dg
+from .settings import AtlasSettings
 from .chart import Chart, ChartQuadrature, build_chart, chart_quadrature
 from .quadrature import simplex_rule
 from .partition import embedding_defects, is_connected, partition_markers, refine_partition
-
-
-@dataclass
-class AtlasSettings:
-    """Numerical parameters of the atlas (thesis Table I / BENCHMARKS.md)."""
-
-    n_patches: Optional[int] = None       # None: from markers_per_patch
-    markers_per_patch: int = 150
-    gamma_lme: float = 0.8
-    tol_lme: float = 1e-10
-    gamma_pu: float = 4.0
-    tol_pu: float = 1e-6
-    quadrature_order: int = 6
-    least_squares_fit: bool = True
-    chart_margin: float = 3.0             # extra control points within margin·h of supp ψ_κ
-    graph_neighbors: int = 10
-    max_stress: float = 0.02              # accept a patch's embedding below this stress ...
-    max_distortion: float = 2.5           # ... and this 95th-percentile singular-value ratio
-    #                                       of the triangles, with no folds
-    max_refinement_depth: int = 6
-
-    def check(self) -> None:
-        for name in ("gamma_lme", "tol_lme", "gamma_pu", "tol_pu", "chart_margin",
-                     "max_stress", "max_distortion"):
-            v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and np.isfinite(v) and v > 0):
-                raise ConfigError(f"{name} = {v!r} is invalid; it must be a finite number > 0.")
-        if self.n_patches is not None and self.n_patches < 1:
-            raise ConfigError(f"n_patches = {self.n_patches!r} is invalid; use None or >= 1.")
-        if self.markers_per_patch < 8:
-            raise ConfigError(f"markers_per_patch = {self.markers_per_patch!r} is invalid; "
-                              "it must be >= 8 (a patch needs enough markers to be embedded).")
 
 
 @dataclass

@@ -7,10 +7,10 @@ per patch, glue with the coarse Shepard partition of unity ψ_κ and integrate
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import ClassVar, Optional
 
 import numpy as np
+from pointatlas_atlas.settings import AtlasSettings
 
 #: exact-reference key -> (metric name, long name)
 QUANTITIES = {
@@ -28,24 +28,8 @@ class SurfaceGeometry:
         "energy and total Gaussian curvature vs exact values."
     )
 
-    @dataclass
-    class Config:
-        #: number of METIS patches before recursive refinement; None: markers / markers_per_patch
-        n_patches: Optional[int] = None
-        markers_per_patch: int = 150
-        gamma_lme: float = 0.8
-        tol_lme: float = 1e-10
-        gamma_pu: float = 4.0
-        tol_pu: float = 1e-6
-        quadrature_order: int = 6
-        #: refit control points so that each chart passes through the samples (Paper 2 App. B)
-        least_squares_fit: bool = True
-        #: control points J_κ: the support of ψ_κ grown by chart_margin · (median spacing)
-        chart_margin: float = 3.0
-        graph_neighbors: int = 10
-        max_stress: float = 0.02
-        max_distortion: float = 2.5
-        max_refinement_depth: int = 6
+    #: the atlas parameters (n_patches, markers_per_patch, gamma_lme, ...): AtlasSettings
+    Config = AtlasSettings
 
     parameter_constraints: ClassVar[dict[str, str]] = {
         "n_patches": "None or int >= 1",
@@ -76,8 +60,6 @@ class SurfaceGeometry:
         self.max_refinement_depth = max_refinement_depth
 
     def settings(self):
-        from pointatlas_atlas.atlas import AtlasSettings
-
         return AtlasSettings(**{k: getattr(self, k) for k in self.Config.__dataclass_fields__})
 
     def build_atlas(self, ctx, cloud):

@@ -107,13 +107,7 @@ class QuarterTruncatedSphere(TruncatedSphere):
     Exact: area πR²(1 + cut)/2, χ = 1 (a disc), genus 0.
     """
 
-    @dataclass
-    class Config:
-        n_points: int = 1000
-        sampling: str = "structured"
-        radius: float = 1.0
-        cut: float = 0.5
-        n_markers: Optional[int] = None
+    # Config, __init__ and checks: inherited from TruncatedSphere (same parameters)
 
     description: ClassVar[str] = "Quarter (x, y ≥ 0) of the truncated sphere (thesis Table 1)."
     name: ClassVar[str] = "quarter_truncated_sphere"

@@ -4,19 +4,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import ClassVar, Optional
 
-from .lle import LLEBase
+from .lle import LLEBase, LLEConfig
 
 
 @dataclass
-class MLLEConfig:
-    n_components: int = 2
-    n_neighbors: int = 12
-    reg: float = 1e-3
+class MLLEConfig(LLEConfig):
+    """LLE's settings plus the tolerance of the modified (multiple-weights) variant."""
+
     modified_tol: float = 1e-12
-    eigen_solver: str = "auto"
-    random_state: Optional[int] = 0
-    aic: bool = False
-    aic_neighbors: Optional[int] = None
 
 
 class MLLE(LLEBase):

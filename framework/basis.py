@@ -47,3 +47,28 @@ class BasisFunctions:
         return csr_matrix(
             (self.gradients[:, k], self.indices, self.indptr), shape=(self.n_points, n_nodes)
         )
+
+    def take(self, rows) -> "BasisFunctions":
+        """The basis at a subset of the points (``rows``: indices or a boolean mask)."""
+        rows = np.asarray(rows)
+        if rows.dtype == bool:
+            rows = np.flatnonzero(rows)
+        counts = np.diff(self.indptr)[rows]
+        indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+        starts = self.indptr[rows]
+        flat = (np.repeat(starts - indptr[:-1], counts) + np.arange(indptr[-1])).astype(np.int64)
+
+        def pick(a):
+            return None if a is None else a[flat]
+
+        return BasisFunctions(
+            indptr=indptr, indices=self.indices[flat], values=self.values[flat],
+            gradients=pick(self.gradients), hessians=pick(self.hessians),
+            outside=None if self.outside is None else self.outside[rows])
+
+    def renumbered(self, node_index) -> "BasisFunctions":
+        """The same basis with node indices mapped through ``node_index`` (local -> global)."""
+        return BasisFunctions(
+            indptr=self.indptr, indices=np.asarray(node_index, dtype=np.int64)[self.indices],
+            values=self.values, gradients=self.gradients, hessians=self.hessians,
+            outside=self.outside)

@@ -122,21 +122,27 @@ class Atlas:
             self.support_.append(psi)
         return self.charts_
 
-    def build_quadrature(self, progress=lambda it, **kw: it, need_second: bool = True
+    def build_quadrature(self, progress=lambda it, **kw: it, need_second: bool = True,
+                         real: Optional[np.ndarray] = None, keep_basis: bool = False
                          ) -> list[ChartQuadrature]:
+        """Gauss points of every chart; ``real`` (N,) bool excludes triangles touching ghost
+        nodes (integrate over the sampled surface only); ``keep_basis`` keeps the basis."""
         s = self.settings
         self.quadrature_ = []
         for k in progress(range(len(self.charts_)), total=len(self.charts_), desc="quadrature"):
             members = np.flatnonzero(self.labels_ == k)
+            J = self.charts_[k].node_index
             self.quadrature_.append(chart_quadrature(
                 self.charts_[k], self.support_[k], lambda X, m=members: self._patch_values(X, m),
-                s.quadrature_order, s.tol_pu, need_second))
+                s.quadrature_order, s.tol_pu, need_second,
+                real=None if real is None else np.asarray(real, bool)[J], keep_basis=keep_basis))
         return self.quadrature_
 
-    def build(self, points, markers=None, progress=lambda it, **kw: it) -> "Atlas":
+    def build(self, points, markers=None, progress=lambda it, **kw: it,
+              real: Optional[np.ndarray] = None, keep_basis: bool = False) -> "Atlas":
         self.partition(points, markers)
         self.build_charts(progress)
-        self.build_quadrature(progress)
+        self.build_quadrature(progress, real=real, keep_basis=keep_basis)
         return self
 
     # -- use ---------------------------------------------------------------------------

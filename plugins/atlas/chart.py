@@ -37,6 +37,7 @@ class ChartQuadrature:
     area_element: np.ndarray  # (m,) J_κ(ξ_g)
     n_candidates: int         # Gauss points before dropping those with ψ_κ ≈ 0
     lost_pu: float            # largest ψ_κ at a Gauss point dropped because LME is undefined
+    basis: object = None      # BasisFunctions at the kept points (global node ids), if asked
 
 
 @dataclass
@@ -99,11 +100,17 @@ def interpolating_control_points(lme, xi: np.ndarray, samples: np.ndarray) -> np
 
 
 def chart_quadrature(chart: Chart, support_at_nodes: np.ndarray, patch_pu: Callable,
-                     order: int, tol_pu: float, need_second: bool = True) -> ChartQuadrature:
+                     order: int, tol_pu: float, need_second: bool = True,
+                     real: np.ndarray | None = None, keep_basis: bool = False
+                     ) -> ChartQuadrature:
     """Gauss points on the Delaunay triangles of Ξ_κ that meet the support of ψ_κ.
 
     support_at_nodes : ψ_κ at the control points (a triangle is used if one of its vertices
         has ψ_κ > tol_pu·1e-3); patch_pu(X) returns ψ_κ at ambient points X (m, D).
+    real : optional (n,) bool over the chart's control points; triangles with a vertex that
+        is not real (a ghost node beyond the boundary, Paper 1 §4.1.2) are not integrated,
+        so the integrals cover the sampled surface only.
+    keep_basis : keep the basis functions at the kept points (global node ids) for assembly.
     """
     xi = chart.xi_nodes
     d = xi.shape[1]
@@ -113,11 +120,15 @@ def chart_quadrature(chart: Chart, support_at_nodes: np.ndarray, patch_pu: Calla
     else:
         simplices = Delaunay(xi).simplices
     keep = support_at_nodes[simplices].max(axis=1) > tol_pu * 1e-3
+    if real is not None:
+        keep &= np.asarray(real, bool)[simplices].all(axis=1)
     simplices = simplices[keep]
     rule = simplex_rule(d, order)
     xg, wg = map_rule_to_simplices(xi[simplices], rule)
     n_candidates = len(wg)
-    X, T, S, outside = chart.evaluate(xg, order=2 if need_second else 1)
+    basis = chart.approximant.evaluate(xg, order=2 if need_second else 1)
+    X, T, S = dg.chart_derivatives(basis, chart.control_points, 2 if need_second else 1)
+    outside = basis.outside if basis.outside is not None else np.zeros(len(xg), bool)
     lost = 0.0
     if outside.any():  # diagnostic: ψ_κ at the control point nearest to each dropped point
         from scipy.spatial import cKDTree
@@ -130,7 +141,10 @@ def chart_quadrature(chart: Chart, support_at_nodes: np.ndarray, patch_pu: Calla
     psi = patch_pu(X)
     J = dg.area_element(T)
     use = psi > tol_pu
+    kept = None
+    if keep_basis:
+        kept = basis.take(np.flatnonzero(inside)[use]).renumbered(chart.node_index)
     return ChartQuadrature(
         xi=xg[use], weights=(wg * J * psi)[use], positions=X[use], tangents=T[use],
         second=None if S is None else S[use], pu=psi[use], area_element=J[use],
-        n_candidates=n_candidates, lost_pu=lost)
+        n_candidates=n_candidates, lost_pu=lost, basis=kept)

@@ -1,0 +1,199 @@
+"""Linear Kirchhoff–Love analysis of a point-set shell, from points to displacements.
+
+Thesis §4 / Paper 1 §3–4 on the atlas of Paper 2: (1) find the boundary of the sampled
+surface and add ghost nodes beyond it (Paper 1 §4.1.2); (2) build the atlas on all nodes with
+the real markers, integrating only over the sampled surface; (3) assemble the stiffness from
+the membrane and bending strain–displacement matrices (Paper 1 App. C); (4) nodal loads;
+(5) supports as constraints, solved by an augmented Lagrangian (App. D, thesis App. E.2);
+(6) displacements at the points, u(x_a) = Σ_b p_b(ξ_a) U_b.
+"""
+from __future__ import annotations
+
+import time
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from pointatlas.errors import InputError
+
+
+@dataclass
+class ShellModel:
+    """Everything a solve needs and produces (arrays in the source's length units)."""
+
+    points: np.ndarray            # (N, 3) the sampled (real) points
+    nodes: np.ndarray             # (N + G, 3) control points: real points, then ghosts
+    boundary: np.ndarray          # (N,) bool
+    curves: list
+    spacing: float
+    atlas: object
+    quadrature: object            # ShellQuadrature over all charts
+    material: object
+    stiffness: object = None
+    forces: np.ndarray | None = None          # (N + G, 3)
+    constraints: object = None
+    nodal_displacement: np.ndarray | None = None  # (N + G, 3) U
+    displacement: np.ndarray | None = None    # (N, 3) u(x_a)
+    solve_info: object = None
+    times: dict = field(default_factory=dict)
+
+    @property
+    def n_ghosts(self) -> int:
+        return self.nodes.shape[0] - self.points.shape[0]
+
+    @property
+    def dof(self) -> int:
+        return 3 * self.nodes.shape[0]
+
+
+@contextmanager
+def _timed(times: dict, key: str):
+    t0 = time.perf_counter()
+    yield
+    times[key] = times.get(key, 0.0) + time.perf_counter() - t0
+
+
+def build_model(cloud, settings, atlas_settings, make_embedder, make_lme, make_pu,
+                log=None) -> ShellModel:
+    """Boundary, ghosts, atlas and quadrature of a shell point cloud (no physics yet)."""
+    from pointatlas_atlas.atlas import Atlas
+    from pointatlas_atlas.boundary import boundary_curves, boundary_mask
+    from pointatlas_atlas.ghosts import ghost_points
+
+    from .material import ShellMaterial
+    from .quadrature_data import concatenate, from_basis
+
+    material = ShellMaterial(young_modulus=settings.young_modulus,
+                             poisson_ratio=settings.poisson_ratio, thickness=settings.thickness)
+    material.check()
+    times: dict = {}
+    P = cloud.points
+    if P.shape[1] != 3:
+        raise InputError(f"a shell needs points in R^3; {cloud.name} has D = {P.shape[1]}.")
+    spacing = float(np.median(cKDTree(P).query(P, k=2)[0][:, 1]))
+    with _timed(times, "boundary"):
+        boundary = boundary_mask(P)
+        curves = boundary_curves(P, boundary) if boundary.any() else []
+        G = (ghost_points(P, boundary, layers=settings.ghost_layers)
+             if boundary.any() and settings.ghost_layers > 0 else np.zeros((0, 3)))
+    nodes = np.vstack([P, G])
+    real = np.arange(nodes.shape[0]) < P.shape[0]
+    markers = cloud.markers if cloud.markers is not None else P
+    atlas = Atlas(atlas_settings, make_embedder, make_lme, make_pu)
+    with _timed(times, "partition"):
+        atlas.partition(nodes, markers)
+    with _timed(times, "charts"):
+        atlas.build_charts()
+    with _timed(times, "quadrature"):
+        atlas.build_quadrature(real=real, keep_basis=True)
+        parts = []
+        for k, cq in enumerate(atlas.quadrature_):
+            if len(cq.weights) == 0:
+                continue
+            parts.append(from_basis(cq.basis, cq.tangents, cq.second, cq.weights,
+                                    np.full(len(cq.weights), k), nodes.shape[0]))
+        quadrature = concatenate(parts)
+    _check_support(atlas, quadrature, nodes.shape[0], real)
+    if log is not None:
+        log.info("%d points (%d on the boundary, %d curves) + %d ghosts; %d patches, "
+                 "%d quadrature points", P.shape[0], int(boundary.sum()), len(curves),
+                 G.shape[0], len(atlas.charts_), len(quadrature.weights))
+    return ShellModel(P, nodes, boundary, curves, spacing, atlas, quadrature, material,
+                      times=times)
+
+
+def _check_support(atlas, q, n_nodes: int, real: np.ndarray) -> None:
+    """Every real node must carry some quadrature (else the cloud is too sparse)."""
+    touched = np.zeros(n_nodes, bool)
+    touched[q.indices] = True
+    lonely = np.flatnonzero(real & ~touched)
+    if lonely.size:
+        raise InputError(
+            f"{lonely.size} point(s) (first: {lonely[:5].tolist()}) lie in no chart's "
+            "quadrature: the point cloud is too sparse or irregular there for the chart support. "
+            "Sample the surface more densely or lower study.markers_per_patch.")
+
+
+def solve_linear(model: ShellModel, settings, log=None) -> ShellModel:
+    """Stiffness, loads, supports and the augmented-Lagrangian solve; fills ``model``."""
+    from pointatlas_atlas.evaluation import basis_at_nodes
+
+    from .constraints import check_rigid_motions, support_constraints
+    from .linear import linear_stiffness
+    from .loads import line_load, point_load, surface_load
+    from .solver import solve_augmented
+
+    t = model.times
+    N_all = model.nodes.shape[0]
+    with _timed(t, "assembly"):
+        K = regularize_ghosts(linear_stiffness(model.quadrature, model.material), model)
+    with _timed(t, "loads"):
+        F = np.zeros((N_all, 3))
+        normals = None
+        for ld in settings.loads:
+            if ld.kind == "point":
+                f, where, dist = point_load(model.atlas, ld.at, ld.force, model.spacing,
+                                            settings.max_load_offset)
+                if log is not None:
+                    log.info("point load %s at %s (projected %.3g away)", list(ld.force),
+                             np.round(where, 6).tolist(), dist)
+                F += f
+            elif ld.kind in ("surface", "pressure"):
+                if ld.kind == "pressure" and normals is None:
+                    normals = _quadrature_normals(model.quadrature)
+                F += surface_load(model.quadrature, N_all, ld.force, ld.pressure, normals)
+            else:
+                F += line_load(model.atlas, model.points, model.boundary, model.curves,
+                               ld.where, ld.force)
+    with _timed(t, "constraints"):
+        cons = support_constraints(model.atlas, model.points, model.boundary, model.curves,
+                                   settings.supports, model.spacing, settings.segment_points)
+        check_rigid_motions(cons.matrix, model.nodes, settings.supports)
+    with _timed(t, "solve"):
+        U, _, info = solve_augmented(K, F.ravel(), cons.matrix, cons.rhs, settings.penalty,
+                                     settings.constraint_tol, method=settings.solver)
+    U = U.reshape(-1, 3)
+    with _timed(t, "post"):
+        basis, _, _ = basis_at_nodes(model.atlas, np.arange(model.points.shape[0]), order=0)
+        u = basis.to_csr(N_all) @ U
+    if log is not None:
+        log.info("solved %d DOF: %d AL iteration(s), constraint violation %.2e",
+                 3 * N_all, info.iterations, info.violation)
+    model.stiffness, model.forces, model.constraints = K, F, cons
+    model.nodal_displacement, model.displacement, model.solve_info = U, u, info
+    return model
+
+
+def regularize_ghosts(K, model: ShellModel, eps: float = 1e-10):
+    """K plus a weak spring ε·mean(diag K) on ghost DOFs, and a unit-scaled one on DOFs no
+    quadrature point sees. A ghost node far out carries basis functions that are ~0 on the
+    sampled surface (cut off by the LME tolerance), so its DOFs are (nearly) free: the
+    spring pins them at 0 without changing the displacement of the surface noticeably."""
+    from scipy.sparse import diags
+
+    n = model.nodes.shape[0]
+    scale = float(K.diagonal().mean())
+    node_w = np.zeros(n)
+    node_w[model.points.shape[0]:] = eps
+    seen = np.zeros(n, bool)
+    seen[model.quadrature.indices] = True
+    node_w[~seen] = 1.0
+    return (K + diags(np.repeat(node_w * scale, 3))).tocsr()
+
+
+def _quadrature_normals(q) -> np.ndarray:
+    n = np.cross(q.reference[:, 0], q.reference[:, 1])
+    return n / np.linalg.norm(n, axis=1)[:, None]
+
+
+def displacement_at(model: ShellModel, x) -> tuple[np.ndarray, np.ndarray]:
+    """(u (3,), projected point (3,)) at the surface point nearest to ``x``."""
+    from pointatlas_atlas.evaluation import basis_at
+    from pointatlas_atlas.projection import closest_point
+
+    proj = closest_point(model.atlas, np.asarray(x, dtype=np.float64).reshape(1, 3))
+    b = basis_at(model.atlas, proj.chart, proj.xi, order=0)
+    u = b.to_csr(model.nodes.shape[0]) @ model.nodal_displacement
+    return u[0], proj.point[0]

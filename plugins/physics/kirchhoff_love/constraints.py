@@ -1,0 +1,204 @@
+"""Essential boundary conditions as linear constraints C U = g on the nodal displacements.
+
+Paper 1 App. D / thesis App. E.2: displacement and rotation conditions are imposed at
+boundary points through Lagrange multipliers (here an augmented Lagrangian, see
+:mod:`.solver`). At a point x on the surface, u(x) = Σ_a p_a U_a and, for Kirchhoff–Love
+kinematics, the linearised change of the unit normal is δn = −(n·u_,α) a^α (a^α the dual
+tangent basis), so:
+
+* displacement rows  e·u(x) = Σ_a p_a e·U_a
+* rotation rows      n·u_,α(x) = Σ_a p_a,α n·U_a        (clamped: δn = 0 ⇔ both vanish)
+* symmetry rows      δn·e = −Σ_α (a^α·e) n·u_,α          (the normal stays in the plane)
+
+Rotation rows are scaled by the node spacing h so every row is a length (one penalty fits).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.sparse import coo_matrix, csr_matrix
+
+from pointatlas.errors import InputError
+
+from .selectors import describe, select
+
+RIGID_MOTIONS = ("translation along x", "translation along y", "translation along z",
+                 "rotation about x", "rotation about y", "rotation about z")
+
+
+@dataclass
+class Constraints:
+    """C (r, 3N) and g (r,) with the support each row comes from and the selected nodes."""
+
+    matrix: csr_matrix
+    rhs: np.ndarray
+    row_support: np.ndarray          # (r,) index into the supports list
+    nodes: list                      # per support: selected point indices
+
+
+def _rows(basis, weights: np.ndarray, which: str, n_dof: int, alpha: int = 0):
+    """COO pieces of rows Σ_a q_a (w·U_a), q = p (which='value') or p_,α ('gradient')."""
+    counts = np.diff(basis.indptr)
+    r = np.repeat(np.arange(basis.n_points), counts)
+    q = basis.values if which == "value" else basis.gradients[:, alpha]
+    rows, cols, vals = [], [], []
+    for j in range(3):
+        rows.append(r)
+        cols.append(3 * basis.indices + j)
+        vals.append(q * weights[r, j])
+    return np.concatenate(rows), np.concatenate(cols), np.concatenate(vals)
+
+
+def _block(pieces, n_rows: int, n_dof: int) -> csr_matrix:
+    r = np.concatenate([p[0] for p in pieces])
+    c = np.concatenate([p[1] for p in pieces])
+    v = np.concatenate([p[2] for p in pieces])
+    return coo_matrix((v, (r, c)), shape=(n_rows, n_dof)).tocsr()
+
+
+def _frames(atlas, chart: np.ndarray, xi: np.ndarray):
+    """Tangents a_α (k, 2, 3), dual vectors a^α (k, 2, 3) and unit normals n (k, 3)."""
+    from pointatlas_atlas import differential_geometry as dg
+
+    T = np.empty((len(chart), 2, 3))
+    for k in np.unique(chart):
+        sel = np.flatnonzero(chart == k)
+        _, T[sel], _, _ = atlas.charts_[k].evaluate(xi[sel], order=1)
+    A = dg.metric(T)
+    dual = np.einsum("kab,kbi->kai", np.linalg.inv(A), T)
+    return T, dual, dg.unit_normal(T)
+
+
+def support_constraints(atlas, points: np.ndarray, boundary: np.ndarray, curves: list,
+                        supports: list, spacing: float, segment_points: int = 1
+                        ) -> Constraints:
+    """Assemble C U = g for all supports; ``points`` are the real (non-ghost) points, which
+    are the first rows of the atlas's control points."""
+    from pointatlas_atlas.evaluation import basis_at
+
+    n_dof = 3 * atlas.points_.shape[0]
+    blocks, rhs, owner, chosen = [], [], [], []
+    for s_i, sup in enumerate(supports):
+        nodes = select(sup.where, points, boundary, curves)
+        chosen.append(nodes)
+        chart, xi = constraint_points(atlas, points, nodes, curves, spacing, segment_points)
+        everywhere = basis_at(atlas, chart, xi, order=1)
+        at_nodes = everywhere.take(np.arange(len(nodes)))
+        T, dual, n = _frames(atlas, chart, xi)
+        pieces, values = [], []
+
+        def add(weights, which="value", alpha=(0,), value=None):
+            """Rows Σ_α Σ_a q_a (w_α·U_a): displacement rows at the nodes only, rotation
+            rows (which='gradient') at the nodes and the segment points."""
+            basis = everywhere if which == "gradient" else at_nodes
+            k = basis.n_points
+            i0 = sum(len(v) for v in values)
+            for a, w in zip(alpha, weights if which == "gradient" else [weights]):
+                rr, cc, vv = _rows(basis, w[:k], which, n_dof, a)
+                pieces.append((rr + i0, cc, vv))
+            values.append(np.zeros(k) if value is None else value)
+
+        eye = np.eye(3)
+        kn, ka = len(nodes), len(chart)
+        if sup.kind in ("clamped", "simply_supported"):
+            for j in range(3):
+                add(np.tile(eye[j], (kn, 1)))
+        if sup.kind == "clamped":  # n·u_,α = 0, α = 1, 2 (δn = 0)
+            for a in range(2):
+                scale = spacing / np.linalg.norm(T[:, a], axis=1)
+                add([n * scale[:, None]], "gradient", (a,))
+        if sup.kind == "symmetry":
+            e = _unit(sup.normal)
+            add(np.tile(e, (kn, 1)))
+            c = dual @ e  # δn·e = −Σ_α (a^α·e) n·u_,α: one row from both derivatives
+            add([n * (spacing * c[:, a])[:, None] for a in range(2)], "gradient", (0, 1))
+        if sup.kind == "diaphragm":
+            e = _unit(sup.normal)
+            t1 = np.cross(e, eye[np.argmin(np.abs(e))])
+            t1 /= np.linalg.norm(t1)
+            for t in (t1, np.cross(e, t1)):
+                add(np.tile(t, (kn, 1)))
+        if sup.kind in ("fixed", "displacement"):
+            comps = sup.components if sup.components else [0, 1, 2]
+            for j in comps:
+                v = None if sup.kind == "fixed" else np.full(kn, float(sup.value[j]))
+                add(np.tile(eye[j], (kn, 1)), value=v)
+        del ka
+        n_rows = sum(len(v) for v in values)
+        blocks.append(_block(pieces, n_rows, n_dof))
+        rhs.append(np.concatenate(values))
+        owner.append(np.full(n_rows, s_i))
+    from scipy.sparse import vstack
+
+    return Constraints(vstack(blocks).tocsr(), np.concatenate(rhs), np.concatenate(owner),
+                       chosen)
+
+
+def constraint_points(atlas, points, nodes, curves, spacing: float, per_segment: int = 1):
+    """(chart, ξ) of the selected nodes plus ``per_segment`` evenly spaced points on every
+    boundary segment joining two selected neighbours along a curve (the thesis integrates
+    the boundary terms with four Gauss points per boundary cell, Paper 1 §4.1.1); a segment
+    point is the chart-space interpolation ξ = (1 − t) ξ_a + t ξ_b in the chart of ξ_a."""
+    from pointatlas_atlas.evaluation import node_charts
+
+    chart, local = node_charts(atlas, nodes)
+    xi = [atlas.charts_[c].xi_nodes[j] for c, j in zip(chart, local)]
+    charts = list(chart)
+    picked = np.zeros(points.shape[0], bool)
+    picked[nodes] = True
+    where = {int(a): i for i, a in enumerate(nodes)}
+    ts = np.arange(1, per_segment + 1) / (per_segment + 1)
+    for curve in curves:
+        c = np.asarray(curve)
+        for a, b in zip(c[:-1], c[1:]):
+            if not (picked[a] and picked[b]) or \
+                    np.linalg.norm(points[a] - points[b]) > 2.0 * spacing:
+                continue
+            k = charts[where[int(a)]]
+            ch = atlas.charts_[k]
+            jb = np.flatnonzero(ch.node_index == b)
+            if jb.size == 0:
+                continue
+            xa, xb = xi[where[int(a)]], ch.xi_nodes[jb[0]]
+            for t in ts:
+                xi.append((1 - t) * xa + t * xb)
+                charts.append(k)
+    return np.asarray(charts, dtype=np.int64), np.asarray(xi).reshape(len(charts), -1)
+
+
+def _unit(v) -> np.ndarray:
+    v = np.asarray(v, dtype=np.float64)
+    norm = np.linalg.norm(v)
+    if not norm > 0:
+        raise InputError(f"normal {list(v)} has zero length; give the plane's normal vector.")
+    return v / norm
+
+
+def rigid_motions(nodes: np.ndarray) -> np.ndarray:
+    """(3N, 6) nodal displacements of the six rigid motions (translations, ω × P_a)."""
+    N = nodes.shape[0]
+    R = np.zeros((3 * N, 6))
+    for j in range(3):
+        R[j::3, j] = 1.0
+        w = np.eye(3)[j]
+        R[:, 3 + j] = np.cross(w, nodes).ravel()
+    return R
+
+
+def check_rigid_motions(C: csr_matrix, nodes: np.ndarray, supports: list, tol: float = 1e-8):
+    """Raise :class:`InputError` if a rigid motion satisfies every constraint (singular
+    problem), naming the free motions and the fix."""
+    R = rigid_motions(nodes)
+    R /= np.linalg.norm(R, axis=0)
+    CR = C @ R
+    w, V = np.linalg.eigh(CR.T @ CR)
+    free = w < tol * max(w.max(), 1e-300)
+    if free.any() or C.shape[0] == 0:
+        names = [RIGID_MOTIONS[int(np.argmax(np.abs(V[:, i])))] for i in np.flatnonzero(free)]
+        held = "; ".join(describe(s.where) + f" ({s.kind})" for s in supports) or "nothing"
+        raise InputError(
+            f"the shell is not held against {len(names)} rigid motion(s) "
+            f"(mostly: {', '.join(names)}): its stiffness is singular. Supports given: {held}. "
+            "Add a support that prevents them, e.g. {kind: fixed, components: [2], where: "
+            "{expression: '...', on_boundary: false}} at one point.")

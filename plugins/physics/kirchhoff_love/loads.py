@@ -1,0 +1,83 @@
+"""External loads as nodal forces F_a = ∂(work)/∂U_a (Paper 1 §3, thesis L363–520).
+
+* point force P at a surface point x: F_a = p_a(ξ) P, with (κ, ξ) the chart preimage of the
+  closest-point projection of the given point (Paper 2 App. A);
+* surface force q per unit area (self weight): F_a = Σ_g w_g p_a(ξ_g) q, with the atlas
+  quadrature weights w_g = w J ψ_κ (thesis §3.4);
+* pressure p along the unit normal: q = p n;
+* line force t per unit length on boundary points: trapezoidal lengths along the ordered
+  boundary curve, F_a = Σ_i ℓ_i p_a(x_i) t.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from pointatlas.errors import InputError
+
+from .selectors import describe, select
+
+
+def point_load(atlas, at, force, spacing: float, max_offset: float):
+    """(F (N, 3), projected point, distance) of a point force at the surface point nearest
+    ``at``; more than ``max_offset`` spacings off the surface is an error."""
+    from pointatlas_atlas.evaluation import basis_at
+    from pointatlas_atlas.projection import closest_point
+
+    x = np.asarray(at, dtype=np.float64).reshape(1, 3)
+    proj = closest_point(atlas, x, on_failure="flag")
+    dist = float(proj.distance[0]) if bool(proj.converged[0]) else np.inf
+    if not dist <= max_offset * spacing:
+        raise InputError(
+            f"the load point {list(at)} is {dist:.3g} off the surface (spacing {spacing:.3g}, "
+            f"allowed {max_offset} spacings): give a point on the shell (check the "
+            "coordinates and the model: full, quarter or eighth).")
+    basis = basis_at(atlas, proj.chart, proj.xi, order=0)
+    F = np.zeros((atlas.points_.shape[0], 3))
+    np.add.at(F, basis.indices, basis.values[:, None] * np.asarray(force, dtype=np.float64))
+    return F, proj.point[0], dist
+
+
+def surface_load(quadrature, n_nodes: int, force=None, pressure=None, normals=None):
+    """Consistent nodal forces of a load per unit area (vector ``force`` or ``pressure``·n)."""
+    q = quadrature
+    counts = np.diff(q.indptr)
+    rows = np.repeat(np.arange(len(q.weights)), counts)
+    if pressure is not None:
+        traction = float(pressure) * normals
+    else:
+        traction = np.broadcast_to(np.asarray(force, dtype=np.float64), (len(q.weights), 3))
+    w = q.basis[:, 0] * q.weights[rows]
+    F = np.zeros((n_nodes, 3))
+    for j in range(3):
+        F[:, j] = np.bincount(q.indices, weights=w * traction[rows, j], minlength=n_nodes)
+    return F
+
+
+def line_load(atlas, points, boundary, curves, where, force):
+    """Nodal forces of a force per unit length on the boundary points ``where`` selects."""
+    from pointatlas_atlas.evaluation import basis_at_nodes
+
+    nodes = select(where, points, boundary, curves)
+    chosen = set(nodes.tolist())
+    length = np.zeros(points.shape[0])
+    for curve in curves:
+        idx = np.asarray(curve["indices"] if isinstance(curve, dict) else curve)
+        closed = bool(curve.get("closed", False)) if isinstance(curve, dict) else False
+        seg = list(zip(idx[:-1], idx[1:])) + ([(idx[-1], idx[0])] if closed else [])
+        for a, b in seg:
+            if a in chosen and b in chosen:
+                ell = np.linalg.norm(points[a] - points[b])
+                length[a] += 0.5 * ell
+                length[b] += 0.5 * ell
+    if not length[nodes].any():
+        raise InputError(f"the line load on {describe(where)} selects {len(nodes)} boundary "
+                         "point(s) but no boundary segment between them: select a stretch of "
+                         "a boundary curve (at least two neighbouring boundary points).")
+    basis, _, _ = basis_at_nodes(atlas, nodes, order=0)
+    counts = np.diff(basis.indptr)
+    w = basis.values * np.repeat(length[nodes], counts)
+    F = np.zeros((atlas.points_.shape[0], 3))
+    t = np.asarray(force, dtype=np.float64)
+    for j in range(3):
+        F[:, j] = np.bincount(basis.indices, weights=w * t[j], minlength=F.shape[0])
+    return F

@@ -1,0 +1,63 @@
+"""The ``kirchhoff_love`` physics plugin: thin shells on a point-set atlas (thesis §4)."""
+from __future__ import annotations
+
+from typing import ClassVar
+
+from pointatlas.stores_config import stores_config
+
+from .settings import ShellSettings, check_settings
+
+
+@stores_config
+class KirchhoffLove:
+    """Kirchhoff–Love shell, St. Venant–Kirchhoff material, LME charts glued by the atlas PU.
+
+    ``solve(ctx, cloud=..., atlas_settings=...)`` runs the linear analysis and returns the
+    displacement field as a Dataset; the model (atlas, stiffness, constraints) is kept in
+    ``model_`` for post-processing (scikit-learn convention for learned state).
+    """
+
+    Config = ShellSettings
+    description: ClassVar[str] = (
+        "Kirchhoff–Love thin shell on the atlas: linear analysis with supports by augmented "
+        "Lagrangian, ghost nodes at boundaries (thesis §4, Papers 1–2).")
+
+    def settings(self) -> ShellSettings:
+        return ShellSettings(**{k: getattr(self, k) for k in ShellSettings.__dataclass_fields__})
+
+    def solve(self, ctx, *, cloud, atlas_settings):
+        """Linear analysis of ``cloud``; returns displacement, forces and sizes (xr.Dataset)."""
+        from .analysis import build_model, solve_linear
+        from .results import field_dataset
+
+        s = _as_settings(self.settings())
+        check_settings(s)
+        model = build_model(
+            cloud, s, atlas_settings,
+            make_embedder=lambda: ctx.plugin("embedder"),
+            make_lme=lambda: ctx.make("approximants", "lme", gamma=atlas_settings.gamma_lme,
+                                      tol=atlas_settings.tol_lme, outside="flag"),
+            make_pu=lambda: ctx.make("approximants", "shepard", gamma=atlas_settings.gamma_pu,
+                                     tol=atlas_settings.tol_pu, outside="flag"),
+            log=ctx.log)
+        solve_linear(model, s, log=ctx.log)
+        self.model_ = model
+        return field_dataset(model)
+
+
+def _as_settings(s: ShellSettings) -> ShellSettings:
+    """Supports, loads and selectors as dataclasses even when they came as dicts."""
+    from .selectors import Selector
+    from .settings import Load, Support
+
+    def sel(x):
+        return x if x is None or isinstance(x, Selector) else Selector(**dict(x))
+
+    s.supports = [x if isinstance(x, Support) else Support(**dict(x)) for x in s.supports]
+    s.loads = [x if isinstance(x, Load) else Load(**dict(x)) for x in s.loads]
+    for family, items in (("supports", s.supports), ("loads", s.loads)):
+        for i, x in enumerate(items):
+            x.where = sel(x.where)
+            if x.where is not None and x.where.name == "selector":
+                x.where.name = f"physics.{family}[{i}].where"
+    return s

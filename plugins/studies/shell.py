@@ -1,0 +1,112 @@
+"""Linear thin-shell analysis of a point cloud and its reference displacement (thesis §4).
+
+The source gives the points of the shell's middle surface; the ``kirchhoff_love`` physics
+plugin builds the atlas (with ghost nodes beyond the boundary), applies the supports and
+loads of its config and solves. The study reads the displacement at ``reference_point``
+along ``reference_direction`` (the sign convention of the published value), compares it with
+``references`` and writes the deformed shape to ``shell.vtp`` for ParaView.
+Obstacle course references: BENCHMARKS.md (plate L1337, Scordelis–Lo and hemisphere L1343,
+cylinder L1427 of the thesis).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import ClassVar, List
+
+import numpy as np
+from pointatlas_atlas.settings import AtlasSettings
+
+from pointatlas.stores_config import stores_config
+
+
+@dataclass
+class ShellStudySettings(AtlasSettings):
+    """Atlas parameters (thesis Table I) plus where and against what to read the result."""
+
+    markers_per_patch: int = 100
+    reference_point: List[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
+    reference_direction: List[float] = field(default_factory=lambda: [0.0, 0.0, -1.0])
+    references: List[float] = field(default_factory=list)
+    reference_labels: List[str] = field(default_factory=list)
+    magnification: float = 0.0      # 0: deformed shape scaled so max |u| is 10 % of the size
+    write_vtp: bool = True
+
+
+@stores_config
+class ShellStudy:
+    """Build the shell's atlas, solve, read the reference displacement, compare, export."""
+
+    Config = ShellStudySettings
+    description: ClassVar[str] = (
+        "Linear Kirchhoff–Love analysis of a point-set shell: displacement at a reference "
+        "point vs published values, deformed shape (.vtp).")
+
+    def atlas_settings(self) -> AtlasSettings:
+        return AtlasSettings(**{k: getattr(self, k) for k in AtlasSettings.__dataclass_fields__})
+
+    def run(self, ctx):
+        from pointatlas.errors import ConfigError
+
+        if ctx.plugin_name("physics") != "kirchhoff_love":
+            raise ConfigError("study=shell needs physics=kirchhoff_love (the shell model); "
+                              f"got physics={ctx.choices.get('physics')!r}.")
+        if len(self.reference_labels) not in (0, len(self.references)):
+            raise ConfigError("study.reference_labels must name each of study.references.")
+        self.atlas_settings().check()
+        with ctx.timed("source"):
+            cloud = ctx.plugin("source").load(ctx.rng("source"))
+        physics = ctx.plugin("physics")
+        with ctx.timed("analysis"):
+            ds = physics.solve(ctx, cloud=cloud, atlas_settings=self.atlas_settings())
+        model = physics.model_
+        return self._results(ctx, ds, model, cloud)
+
+    def _results(self, ctx, ds, model, cloud):
+        from pointatlas_physics.kirchhoff_love.analysis import displacement_at
+        from pointatlas_physics.kirchhoff_love.results import write_vtp
+
+        e = np.asarray(self.reference_direction, dtype=np.float64)
+        e = e / np.linalg.norm(e)
+        u, x = displacement_at(model, self.reference_point)
+        value = float(u @ e)
+        ds["displacement"] = ((), value, {
+            "long_name": f"displacement at the reference point along {np.round(e, 6).tolist()}",
+            "units": "length", "reference_point": list(map(float, x))})
+        refs = [float(r) for r in self.references]
+        labels = list(self.reference_labels) or [f"reference {i}" for i in range(len(refs))]
+        if refs:
+            ds["displacement"].attrs.update(reference=refs[0], reference_source=labels[0])
+            ds["relative_error"] = ((), abs(value - refs[0]) / abs(refs[0]), {
+                "long_name": f"|displacement − ref| / |ref|, ref = {refs[0]} ({labels[0]})",
+                "units": "1"})
+            ds = ds.assign_coords(reference=("reference", labels, {
+                "long_name": "published value", "units": "1"}))
+            ds["reference_value"] = (("reference",), refs, {"long_name": "published value",
+                                                            "units": "length"})
+            ds["relative_error_vs"] = (("reference",),
+                                       [abs(value - r) / abs(r) for r in refs],
+                                       {"long_name": "relative error against each reference",
+                                        "units": "1"})
+            ctx.log.info("displacement %.8g; relative error %s", value, ", ".join(
+                f"{lab}: {abs(value - r) / abs(r):.3e}" for lab, r in zip(labels, refs)))
+        size = float(np.ptp(model.points, axis=0).max())
+        umax = float(ds["max_displacement"])
+        mag = self.magnification or (0.1 * size / umax if umax > 0 else 1.0)
+        ds.attrs["magnification"] = mag
+        ds.attrs["title"] = f"Kirchhoff–Love shell: {cloud.name}, {int(ds['dof'])} DOF"
+        if self.write_vtp:
+            write_vtp(model, ctx.run_dir / "shell.vtp", mag)
+        return ds
+
+    @staticmethod
+    def report_figures(ds):
+        from pointatlas_physics.kirchhoff_love.results import deformed_picture
+
+        return [("Deformed shape (displacement magnified "
+                 f"{float(ds.attrs.get('magnification', 1.0)):.3g}×)", deformed_picture(ds))]
+
+    @staticmethod
+    def report_sweep_figures(ds):
+        from pointatlas_physics.kirchhoff_love.convergence import convergence_figures
+
+        return convergence_figures(ds)

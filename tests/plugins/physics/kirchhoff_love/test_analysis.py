@@ -1,0 +1,93 @@
+"""Points to displacement on a small quarter plate: loads, supports, solve, errors."""
+import numpy as np
+import pytest
+
+import pointatlas
+from pointatlas.errors import InputError
+from pointatlas_atlas.settings import AtlasSettings
+from pointatlas_physics.kirchhoff_love.analysis import build_model, displacement_at, solve_linear
+from pointatlas_physics.kirchhoff_love.selectors import Selector
+from pointatlas_physics.kirchhoff_love.settings import Load, ShellSettings, Support
+
+E, NU, H, L, F = 1.0e6, 0.3, 0.1, 10.0, 200.0
+D = E * H**3 / (12 * (1 - NU**2))
+
+
+def _settings(supports=None, loads=None):
+    plane = lambda n, d: Selector(plane=[*n, d])  # noqa: E731
+    return ShellSettings(
+        young_modulus=E, poisson_ratio=NU, thickness=H, penalty=1e6,
+        supports=supports if supports is not None else [
+            Support(kind="clamped", where=plane([1, 0, 0], 5.0)),
+            Support(kind="clamped", where=plane([0, 1, 0], 5.0)),
+            Support(kind="symmetry", normal=[1, 0, 0], where=plane([1, 0, 0], 0.0)),
+            Support(kind="symmetry", normal=[0, 1, 0], where=plane([0, 1, 0], 0.0))],
+        loads=loads if loads is not None else [
+            Load(kind="point", at=[0, 0, 0], force=[0, 0, -F / 4])])
+
+
+def _model(settings):
+    cloud = pointatlas.load_plugin("sources", "square_plate")(
+        n_points=196, model="quarter", length=L).load(np.random.default_rng(0))
+    atlas = AtlasSettings(markers_per_patch=100, quadrature_order=4)
+    return build_model(
+        cloud, settings, atlas,
+        make_embedder=lambda: pointatlas.load_plugin("embedders", "pca")(n_components=2),
+        make_lme=lambda: pointatlas.load_plugin("approximants", "lme")(gamma=0.8, tol=1e-8,
+                                                                      outside="flag"),
+        make_pu=lambda: pointatlas.load_plugin("approximants", "shepard")(gamma=4.0, tol=1e-6,
+                                                                         outside="flag"))
+
+
+@pytest.fixture(scope="module")
+def solved():
+    s = _settings()
+    return solve_linear(_model(s), s), s
+
+
+def test_ghosts_and_quadrature_cover_the_plate(solved):
+    model, _ = solved
+    assert model.n_ghosts > 0 and model.boundary.sum() >= 4 * 12
+    assert model.quadrature.weights.sum() == pytest.approx((L / 2) ** 2, rel=1e-8)
+
+
+def test_point_load_is_consistent_and_supports_hold(solved):
+    model, _ = solved
+    np.testing.assert_allclose(model.forces.sum(axis=0), [0, 0, -F / 4], atol=1e-12)
+    C = model.constraints.matrix
+    assert np.abs(C @ model.nodal_displacement.ravel()).max() < 1e-8
+    u, _ = displacement_at(model, [5.0, 2.0, 0.0])  # on the clamped edge
+    assert np.abs(u).max() < 1e-6 * np.abs(model.displacement).max()
+
+
+def test_centre_deflection_close_to_reference(solved):
+    model, _ = solved
+    u, x = displacement_at(model, [0.0, 0.0, 0.0])
+    w_ref = 0.0056122 * F * L**2 / D
+    assert u[2] < 0 and abs(-u[2] - w_ref) / w_ref < 0.08
+    assert np.abs(u[:2]).max() < 1e-8  # a flat plate bends without in-plane motion
+
+
+def test_surface_load_totals_weight():
+    from pointatlas_physics.kirchhoff_love.loads import surface_load
+
+    s = _settings()
+    model = _model(s)
+    f = surface_load(model.quadrature, model.nodes.shape[0], force=[0, 0, -90.0])
+    assert f.sum(axis=0) == pytest.approx([0, 0, -90.0 * 25.0], rel=1e-8)
+
+
+def test_unheld_shell_names_the_free_motions():
+    s = _settings(supports=[Support(kind="symmetry", normal=[1, 0, 0],
+                                    where=Selector(plane=[1, 0, 0, 0.0]))])
+    with pytest.raises(InputError, match="rigid motion"):
+        solve_linear(_model(s), s)
+
+
+def test_load_off_the_surface_and_empty_selector_are_errors():
+    s = _settings(loads=[Load(kind="point", at=[0, 0, 3.0], force=[0, 0, -1])])
+    with pytest.raises(InputError, match="off the surface"):
+        solve_linear(_model(s), s)
+    s = _settings(supports=[Support(kind="clamped", where=Selector(plane=[1, 0, 0, 7.0]))])
+    with pytest.raises(InputError, match="select"):
+        solve_linear(_model(s), s)

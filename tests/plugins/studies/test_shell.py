@@ -1,0 +1,56 @@
+"""The shell study end to end from the command line, and its convergence post-processing."""
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from pointatlas import open_run
+from pointatlas_physics.kirchhoff_love.convergence import (convergence_figures,
+                                                          convergence_table, last_rate)
+
+
+def test_plate_run_writes_results_vtp_and_report(tmp_path, run_cli):
+    out = tmp_path / "out"
+    r = run_cli("pointatlas", "experiment=shell_plate", "source.n_points=196",
+                "study.quadrature_order=4", f"outputs_root={out}", "quiet=true", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr[-2000:]
+    run_dir = next(out.glob("runs/*/*"))
+    ds = open_run(run_dir)
+    for v in list(ds.data_vars) + list(ds.coords):
+        assert "long_name" in ds[v].attrs and "units" in ds[v].attrs, v
+    assert int(ds["dof"]) == 3 * (int(ds["n_points"]) + int(ds["n_ghosts"]))
+    assert ds["displacement"].attrs["reference"] == pytest.approx(1.2257045)
+    assert float(ds["relative_error"]) < 0.01  # 0.2 % at this size (thesis value)
+    assert list(ds["reference"].values)[0].startswith("thesis")
+    assert ds["displacement_field"].dims == ("point", "dim")
+    assert (run_dir / "shell.vtp").stat().st_size > 0
+    r = run_cli("pointatlas-report", str(run_dir), cwd=tmp_path)
+    assert r.returncode == 0, r.stderr[-2000:]
+    assert "Deformed shape" in (run_dir / "report.html").read_text()
+
+
+def _sweep(dofs, disps, refs=(1.0, 1.01)):
+    n = len(dofs)
+    return xr.Dataset(
+        {"dof": (("n",), dofs), "displacement": (("n",), disps),
+         "reference_value": (("n", "reference"), np.tile(refs, (n, 1))),
+         "time_assembly": (("n",), np.linspace(1, 2, n)),
+         "time_solve": (("n",), np.linspace(0.1, 0.2, n))},
+        coords={"n": np.arange(n), "reference": ["a", "b"]})
+
+
+def test_convergence_rate_and_monotonicity():
+    dofs = np.array([4000.0, 1000.0, 2000.0, 8000.0])  # unsorted on purpose
+    errs = 0.05 * (dofs / 1000.0) ** -1.0
+    t = convergence_table(_sweep(dofs, 1.0 + errs))
+    assert t["dof"].tolist() == [1000, 2000, 4000, 8000]
+    assert t["rate"] == pytest.approx(-1.0, abs=1e-9)
+    assert t["monotone"]
+    np.testing.assert_allclose(t["errors"][:, 1], np.abs(1.0 + np.sort(errs)[::-1] - 1.01) / 1.01)
+    bumpy = convergence_table(_sweep(dofs, 1.0 + np.array([0.01, 0.05, 0.02, 0.03])))
+    assert not bumpy["monotone"]
+    assert np.isnan(last_rate(np.array([1.0]), np.array([0.1])))
+    titles = [t for t, _ in convergence_figures(_sweep(dofs, 1.0 + errs))]
+    assert "rate over the last three refinements: -1.00" in titles[0]
+    assert len(titles) == 3

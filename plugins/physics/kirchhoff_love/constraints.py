@@ -71,10 +71,17 @@ def _frames(atlas, chart: np.ndarray, xi: np.ndarray):
 
 
 def support_constraints(atlas, points: np.ndarray, boundary: np.ndarray, curves: list,
-                        supports: list, spacing: float, segment_points: int = 1
+                        supports: list, spacing: float, segment_points: int = 4
                         ) -> Constraints:
     """Assemble C U = g for all supports; ``points`` are the real (non-ghost) points, which
-    are the first rows of the atlas's control points."""
+    are the first rows of the atlas's control points.
+
+    Each constraint c(x) = 0 is imposed weakly with one multiplier per selected boundary node
+    (Paper 1 App. D): row_i = ∫ N_i c ds / ∫ N_i ds with N_i the hat function of node i along
+    the boundary curve, integrated with ``segment_points`` Gauss points per boundary segment
+    (thesis: four per boundary cell). A node with no selected neighbour along a curve (e.g. a
+    single held point) is collocated. ``segment_points = 0`` collocates at every node.
+    """
     from pointatlas_atlas.evaluation import basis_at
 
     n_dof = 3 * atlas.points_.shape[0]
@@ -82,35 +89,31 @@ def support_constraints(atlas, points: np.ndarray, boundary: np.ndarray, curves:
     for s_i, sup in enumerate(supports):
         nodes = select(sup.where, points, boundary, curves)
         chosen.append(nodes)
-        chart, xi = constraint_points(atlas, points, nodes, curves, spacing, segment_points)
-        everywhere = basis_at(atlas, chart, xi, order=1)
-        at_nodes = everywhere.take(np.arange(len(nodes)))
+        chart, xi, A = boundary_quadrature(atlas, points, nodes, curves, spacing,
+                                           segment_points)
+        basis = basis_at(atlas, chart, xi, order=1)
         T, dual, n = _frames(atlas, chart, xi)
-        pieces, values = [], []
+        k = len(chart)
+        rows, values = [], []
 
-        def add(weights, which="value", alpha=(0,), value=None):
-            """Rows Σ_α Σ_a q_a (w_α·U_a): displacement rows at the nodes only, rotation
-            rows (which='gradient') at the nodes and the segment points."""
-            basis = everywhere if which == "gradient" else at_nodes
-            k = basis.n_points
-            i0 = sum(len(v) for v in values)
-            for a, w in zip(alpha, weights if which == "gradient" else [weights]):
-                rr, cc, vv = _rows(basis, w[:k], which, n_dof, a)
-                pieces.append((rr + i0, cc, vv))
-            values.append(np.zeros(k) if value is None else value)
+        def add(weights, which="value", alpha=(0,), value=0.0):
+            """Weak rows A·[Σ_α Σ_a q_a (w_α·U_a)] at the boundary quadrature points."""
+            pieces = [_rows(basis, w, which, n_dof, a)
+                      for a, w in zip(alpha, weights if which == "gradient" else [weights])]
+            rows.append(A @ _block(pieces, k, n_dof))
+            values.append(np.full(A.shape[0], float(value)))
 
         eye = np.eye(3)
-        kn, ka = len(nodes), len(chart)
         if sup.kind in ("clamped", "simply_supported"):
             for j in range(3):
-                add(np.tile(eye[j], (kn, 1)))
+                add(np.tile(eye[j], (k, 1)))
         if sup.kind == "clamped":  # n·u_,α = 0, α = 1, 2 (δn = 0)
             for a in range(2):
                 scale = spacing / np.linalg.norm(T[:, a], axis=1)
                 add([n * scale[:, None]], "gradient", (a,))
         if sup.kind == "symmetry":
             e = _unit(sup.normal)
-            add(np.tile(e, (kn, 1)))
+            add(np.tile(e, (k, 1)))
             c = dual @ e  # δn·e = −Σ_α (a^α·e) n·u_,α: one row from both derivatives
             add([n * (spacing * c[:, a])[:, None] for a in range(2)], "gradient", (0, 1))
         if sup.kind == "diaphragm":
@@ -118,28 +121,35 @@ def support_constraints(atlas, points: np.ndarray, boundary: np.ndarray, curves:
             t1 = np.cross(e, eye[np.argmin(np.abs(e))])
             t1 /= np.linalg.norm(t1)
             for t in (t1, np.cross(e, t1)):
-                add(np.tile(t, (kn, 1)))
+                add(np.tile(t, (k, 1)))
         if sup.kind in ("fixed", "displacement"):
             comps = sup.components if sup.components else [0, 1, 2]
             for j in comps:
-                v = None if sup.kind == "fixed" else np.full(kn, float(sup.value[j]))
-                add(np.tile(eye[j], (kn, 1)), value=v)
-        del ka
-        n_rows = sum(len(v) for v in values)
-        blocks.append(_block(pieces, n_rows, n_dof))
+                add(np.tile(eye[j], (k, 1)),
+                    value=0.0 if sup.kind == "fixed" else float(sup.value[j]))
+        from scipy.sparse import vstack
+
+        block = vstack(rows).tocsr()
+        blocks.append(block)
         rhs.append(np.concatenate(values))
-        owner.append(np.full(n_rows, s_i))
+        owner.append(np.full(block.shape[0], s_i))
     from scipy.sparse import vstack
 
     return Constraints(vstack(blocks).tocsr(), np.concatenate(rhs), np.concatenate(owner),
                        chosen)
 
 
-def constraint_points(atlas, points, nodes, curves, spacing: float, per_segment: int = 1):
-    """(chart, ξ) of the selected nodes plus ``per_segment`` evenly spaced points on every
-    boundary segment joining two selected neighbours along a curve (the thesis integrates
-    the boundary terms with four Gauss points per boundary cell, Paper 1 §4.1.1); a segment
-    point is the chart-space interpolation ξ = (1 − t) ξ_a + t ξ_b in the chart of ξ_a."""
+def boundary_quadrature(atlas, points, nodes, curves, spacing: float, n_gauss: int = 4):
+    """(chart, ξ, A): evaluation points on the selected boundary and the (k_nodes, n_eval)
+    matrix A of hat-function weights, rows normalised to sum 1.
+
+    The points are the nodes themselves (used by collocated nodes) and ``n_gauss``
+    Gauss–Legendre points on every segment joining two selected neighbours along a curve;
+    a segment point is the chart-space interpolation ξ = (1 − t) ξ_a + t ξ_b in the chart
+    of node a, with weight w_g ℓ_ab N(t) towards each end node.
+    """
+    from scipy.sparse import coo_matrix as coo
+
     from pointatlas_atlas.evaluation import node_charts
 
     chart, local = node_charts(atlas, nodes)
@@ -148,23 +158,39 @@ def constraint_points(atlas, points, nodes, curves, spacing: float, per_segment:
     picked = np.zeros(points.shape[0], bool)
     picked[nodes] = True
     where = {int(a): i for i, a in enumerate(nodes)}
-    ts = np.arange(1, per_segment + 1) / (per_segment + 1)
-    for curve in curves:
+    if n_gauss > 0:
+        tg, wg = np.polynomial.legendre.leggauss(n_gauss)
+        tg, wg = 0.5 * (tg + 1.0), 0.5 * wg
+    rows, cols, vals = [], [], []
+    covered = np.zeros(len(nodes), bool)
+    for curve in curves if n_gauss > 0 else []:
         c = np.asarray(curve)
         for a, b in zip(c[:-1], c[1:]):
-            if not (picked[a] and picked[b]) or \
-                    np.linalg.norm(points[a] - points[b]) > 2.0 * spacing:
+            ell = np.linalg.norm(points[a] - points[b])
+            if not (picked[a] and picked[b]) or ell > 2.0 * spacing:
                 continue
-            k = charts[where[int(a)]]
-            ch = atlas.charts_[k]
-            jb = np.flatnonzero(ch.node_index == b)
+            ia, ib = where[int(a)], where[int(b)]
+            k = charts[ia]
+            jb = np.flatnonzero(atlas.charts_[k].node_index == b)
             if jb.size == 0:
                 continue
-            xa, xb = xi[where[int(a)]], ch.xi_nodes[jb[0]]
-            for t in ts:
+            xa, xb = xi[ia], atlas.charts_[k].xi_nodes[jb[0]]
+            for t, w in zip(tg, wg):
+                e = len(charts)
                 xi.append((1 - t) * xa + t * xb)
                 charts.append(k)
-    return np.asarray(charts, dtype=np.int64), np.asarray(xi).reshape(len(charts), -1)
+                rows += [ia, ib]
+                cols += [e, e]
+                vals += [w * ell * (1 - t), w * ell * t]
+            covered[[ia, ib]] = True
+    lone = np.flatnonzero(~covered)
+    rows += lone.tolist()
+    cols += lone.tolist()
+    vals += [1.0] * lone.size
+    A = coo((vals, (rows, cols)), shape=(len(nodes), len(charts))).tocsr()
+    A = (coo((1.0 / np.asarray(A.sum(axis=1)).ravel(), (np.arange(len(nodes)),) * 2),
+             shape=(len(nodes),) * 2) @ A).tocsr()
+    return (np.asarray(charts, dtype=np.int64), np.asarray(xi).reshape(len(charts), -1), A)
 
 
 def _unit(v) -> np.ndarray:

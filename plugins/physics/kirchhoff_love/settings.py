@@ -63,7 +63,7 @@ class ShellSettings:
     thickness: float = 0.1
     supports: List[Support] = field(default_factory=list)
     loads: List[Load] = field(default_factory=list)
-    segment_points: int = 1          # extra constraint points per boundary segment
+    segment_points: int = 4          # Gauss points per boundary segment (0: collocate)
     ghost_layers: int = 2            # ghost node layers beyond the boundary (Paper 1 §4.1.2)
     solver: str = "direct"           # sparse direct (SuperLU) or CG with incomplete LU
     penalty: float = 1.0e6           # augmented-Lagrangian penalty, relative to diag(K)

@@ -14,10 +14,13 @@ from typing import ClassVar, Optional
 
 import numpy as np
 
+from pointatlas.stores_config import stores_config
+
 from .shell_source import SHELL_CONSTRAINTS, ShellSource, intervals, jitter, rectangle_grid
 from .surface_source import require_positive
 
 
+@stores_config
 class Cylinder(ShellSource):
     """Cylinder (R cosφ, R sinφ, z): full φ ∈ [0, 2π), quarter/eighth φ ∈ [0, π/2].
 
@@ -45,15 +48,6 @@ class Cylinder(ShellSource):
     models: ClassVar[tuple[str, ...]] = ("full", "quarter", "eighth")
     name: ClassVar[str] = "cylinder"
 
-    def __init__(self, *, n_points: int = 800, sampling: str = "structured",
-                 radius: float = 300.0, length: float = 600.0, model: str = "full",
-                 n_markers: Optional[int] = None):
-        self.n_points = n_points
-        self.sampling = sampling
-        self.radius = radius
-        self.length = length
-        self.model = model
-        self.n_markers = n_markers
 
     def _check(self) -> None:
         require_positive("radius", self.radius)

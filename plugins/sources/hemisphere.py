@@ -12,10 +12,13 @@ from typing import ClassVar, Optional
 
 import numpy as np
 
+from pointatlas.stores_config import stores_config
+
 from .shell_source import JITTER, SHELL_CONSTRAINTS, ShellSource, intervals
 from .surface_source import require, require_positive
 
 
+@stores_config
 class Hemisphere(ShellSource):
     """Hemisphere R (sinθ cosφ, sinθ sinφ, cosθ), θ ∈ [hole, 90°]; full or quarter (φ ≤ 90°).
 
@@ -47,15 +50,6 @@ class Hemisphere(ShellSource):
         "model": "'full' or 'quarter' (x >= 0, y >= 0)"}
     name: ClassVar[str] = "hemisphere"
 
-    def __init__(self, *, n_points: int = 800, sampling: str = "structured",
-                 radius: float = 10.0, hole_angle_deg: float = 0.0, model: str = "full",
-                 n_markers: Optional[int] = None):
-        self.n_points = n_points
-        self.sampling = sampling
-        self.radius = radius
-        self.hole_angle_deg = hole_angle_deg
-        self.model = model
-        self.n_markers = n_markers
 
     def _check(self) -> None:
         require_positive("radius", self.radius)

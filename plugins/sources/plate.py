@@ -10,10 +10,13 @@ from typing import ClassVar, Optional
 
 import numpy as np
 
+from pointatlas.stores_config import stores_config
+
 from .shell_source import SHELL_CONSTRAINTS, ShellSource, intervals, jitter, rectangle_grid
 from .surface_source import require_positive
 
 
+@stores_config
 class SquarePlate(ShellSource):
     """Square plate of side ``length`` in z = 0 (full: [−L/2, L/2]², quarter: [0, L/2]²).
 
@@ -37,13 +40,6 @@ class SquarePlate(ShellSource):
         "model": "'full' ([-L/2, L/2]^2) or 'quarter' ([0, L/2]^2)"}
     name: ClassVar[str] = "square_plate"
 
-    def __init__(self, *, n_points: int = 441, sampling: str = "structured",
-                 length: float = 10.0, model: str = "full", n_markers: Optional[int] = None):
-        self.n_points = n_points
-        self.sampling = sampling
-        self.length = length
-        self.model = model
-        self.n_markers = n_markers
 
     def _check(self) -> None:
         require_positive("length", self.length)

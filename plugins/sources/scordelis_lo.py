@@ -12,10 +12,13 @@ from typing import ClassVar, Optional
 
 import numpy as np
 
+from pointatlas.stores_config import stores_config
+
 from .shell_source import SHELL_CONSTRAINTS, ShellSource, intervals, jitter, rectangle_grid
 from .surface_source import require, require_positive
 
 
+@stores_config
 class ScordelisLoRoof(ShellSource):
     """Cylindrical roof (x, z) = R (sinθ, cosθ), |θ| ≤ half_angle, |y| ≤ L/2.
 
@@ -42,16 +45,6 @@ class ScordelisLoRoof(ShellSource):
         "model": "'full' or 'quarter' (theta >= 0, y >= 0)"}
     name: ClassVar[str] = "scordelis_lo_roof"
 
-    def __init__(self, *, n_points: int = 600, sampling: str = "structured",
-                 radius: float = 25.0, length: float = 50.0, half_angle_deg: float = 40.0,
-                 model: str = "full", n_markers: Optional[int] = None):
-        self.n_points = n_points
-        self.sampling = sampling
-        self.radius = radius
-        self.length = length
-        self.half_angle_deg = half_angle_deg
-        self.model = model
-        self.n_markers = n_markers
 
     def _check(self) -> None:
         require_positive("radius", self.radius)

@@ -19,10 +19,9 @@ from typing import ClassVar
 
 import numpy as np
 
-from pointatlas.errors import ConfigError
 from pointatlas.pointcloud import PointCloud, check_distinct
 
-from .surface_source import COMMON_CONSTRAINTS, SurfaceSource, require
+from .surface_source import COMMON_CONSTRAINTS, SurfaceSource, check_rng, require
 
 #: Maximal jitter of the 'random' samplings, as a fraction of the local grid spacing.
 JITTER = 0.3
@@ -115,11 +114,7 @@ class ShellSource(SurfaceSource):
 
     def load(self, rng: np.random.Generator) -> PointCloud:
         """Sample the surface and its markers; all randomness comes from ``rng``."""
-        if not isinstance(rng, np.random.Generator):
-            raise ConfigError(
-                f"rng must be a numpy.random.Generator, got {type(rng).__name__}. "
-                "Pass numpy.random.default_rng(seed)."
-            )
+        check_rng(rng)
         self._check_common()
         self._check_model()
         self._check()

@@ -38,6 +38,13 @@ def require_positive(name: str, value) -> None:
     )
 
 
+def check_rng(rng) -> None:
+    """Raise :class:`ConfigError` unless ``rng`` is a numpy Generator."""
+    if not isinstance(rng, np.random.Generator):
+        raise ConfigError(f"rng must be a numpy.random.Generator, got "
+                          f"{type(rng).__name__}. Pass numpy.random.default_rng(seed).")
+
+
 class SurfaceSource:
     """Base of the analytic surfaces; not a plugin by itself."""
 
@@ -82,11 +89,7 @@ class SurfaceSource:
 
     def load(self, rng: np.random.Generator) -> PointCloud:
         """Sample the surface; all randomness comes from ``rng``."""
-        if not isinstance(rng, np.random.Generator):
-            raise ConfigError(
-                f"rng must be a numpy.random.Generator, got {type(rng).__name__}. "
-                "Pass numpy.random.default_rng(seed)."
-            )
+        check_rng(rng)
         self._check_common()
         self._check()
         points, params = self._sample(int(self.n_points), self.sampling, rng)

@@ -241,3 +241,23 @@ def outward_conormals(points, mask, n_neighbors: int = 12) -> np.ndarray:
     world = np.einsum("bk,bkj->bj", tangent, geo["frames"])
     out[geo["idx"]] = world / np.linalg.norm(world, axis=1, keepdims=True)
     return out
+
+
+def curve_segments(points, curves, max_length: float) -> np.ndarray:
+    """(s, 2) index pairs of neighbouring points along the ordered curves, the closing pair
+    of closed curves included; pairs longer than ``max_length`` (jumps in the ordering of a
+    branched curve) are left out."""
+    X = np.asarray(points, dtype=np.float64)
+    pairs = []
+    for curve in curves:
+        c = np.asarray(curve, dtype=np.int64)
+        if len(c) < 2:
+            continue
+        p = np.column_stack([c[:-1], c[1:]])
+        if len(c) >= 3 and np.linalg.norm(X[c[0]] - X[c[-1]]) <= max_length:
+            p = np.vstack([p, [c[-1], c[0]]])
+        pairs.append(p)
+    if not pairs:
+        return np.zeros((0, 2), dtype=np.int64)
+    p = np.vstack(pairs)
+    return p[np.linalg.norm(X[p[:, 0]] - X[p[:, 1]], axis=1) <= max_length]

@@ -142,7 +142,7 @@ def solve_linear(model: ShellModel, settings, log=None) -> ShellModel:
                 F += f
             elif ld.kind in ("surface", "pressure"):
                 if ld.kind == "pressure" and normals is None:
-                    normals = _quadrature_normals(model.quadrature)
+                    normals = _quadrature_normals(model.quadrature, model.nodes)
                 F += surface_load(model.quadrature, N_all, ld.force, ld.pressure, normals)
             else:
                 F += line_load(model.atlas, model.points, model.boundary, model.curves,
@@ -183,9 +183,19 @@ def regularize_ghosts(K, model: ShellModel, eps: float = 1e-10):
     return (K + diags(np.repeat(node_w * scale, 3))).tocsr()
 
 
-def _quadrature_normals(q) -> np.ndarray:
+def _quadrature_normals(q, nodes: np.ndarray) -> np.ndarray:
+    """Unit normals at the quadrature points, oriented away from the centroid of the nodes
+    (charts have their own orientations; a pressure > 0 pushes a closed shell outwards)."""
     n = np.cross(q.reference[:, 0], q.reference[:, 1])
-    return n / np.linalg.norm(n, axis=1)[:, None]
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    rows = np.repeat(np.arange(len(q.weights)), np.diff(q.indptr))
+    x = np.zeros((len(q.weights), 3))
+    for j in range(3):
+        x[:, j] = np.bincount(rows, weights=q.basis[:, 0] * nodes[q.indices, j],
+                              minlength=len(q.weights))
+    flip = np.einsum("ij,ij->i", n, x - nodes.mean(axis=0)) < 0
+    n[flip] *= -1.0
+    return n
 
 
 def displacement_at(model: ShellModel, x) -> tuple[np.ndarray, np.ndarray]:

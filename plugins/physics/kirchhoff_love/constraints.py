@@ -163,12 +163,11 @@ def boundary_quadrature(atlas, points, nodes, curves, spacing: float, n_gauss: i
         tg, wg = 0.5 * (tg + 1.0), 0.5 * wg
     rows, cols, vals = [], [], []
     covered = np.zeros(len(nodes), bool)
-    for curve in curves if n_gauss > 0 else []:
-        c = np.asarray(curve)
-        for a, b in zip(c[:-1], c[1:]):
-            ell = np.linalg.norm(points[a] - points[b])
-            if not (picked[a] and picked[b]) or ell > 2.0 * spacing:
-                continue
+    from pointatlas_atlas.boundary import curve_segments
+
+    for a, b in curve_segments(points, curves, 2.0 * spacing) if n_gauss > 0 else []:
+        ell = np.linalg.norm(points[a] - points[b])
+        if picked[a] and picked[b]:  # a segment of the selected boundary
             ia, ib = where[int(a)], where[int(b)]
             k = charts[ia]
             jb = np.flatnonzero(atlas.charts_[k].node_index == b)

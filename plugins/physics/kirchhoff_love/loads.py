@@ -58,17 +58,15 @@ def line_load(atlas, points, boundary, curves, where, force):
     from pointatlas_atlas.evaluation import basis_at_nodes
 
     nodes = select(where, points, boundary, curves)
-    chosen = set(nodes.tolist())
-    length = np.zeros(points.shape[0])
-    for curve in curves:
-        idx = np.asarray(curve["indices"] if isinstance(curve, dict) else curve)
-        closed = bool(curve.get("closed", False)) if isinstance(curve, dict) else False
-        seg = list(zip(idx[:-1], idx[1:])) + ([(idx[-1], idx[0])] if closed else [])
-        for a, b in seg:
-            if a in chosen and b in chosen:
-                ell = np.linalg.norm(points[a] - points[b])
-                length[a] += 0.5 * ell
-                length[b] += 0.5 * ell
+    from pointatlas_atlas.boundary import curve_segments
+
+    picked = np.zeros(points.shape[0], bool)
+    picked[nodes] = True
+    seg = curve_segments(points, curves, 2.0 * _spacing(points))
+    seg = seg[picked[seg[:, 0]] & picked[seg[:, 1]]]
+    ell = np.linalg.norm(points[seg[:, 0]] - points[seg[:, 1]], axis=1)
+    length = 0.5 * (np.bincount(seg[:, 0], ell, points.shape[0])
+                    + np.bincount(seg[:, 1], ell, points.shape[0]))
     if not length[nodes].any():
         raise InputError(f"the line load on {describe(where)} selects {len(nodes)} boundary "
                          "point(s) but no boundary segment between them: select a stretch of "
@@ -81,3 +79,9 @@ def line_load(atlas, points, boundary, curves, where, force):
     for j in range(3):
         F[:, j] = np.bincount(basis.indices, weights=w * t[j], minlength=F.shape[0])
     return F
+
+
+def _spacing(points: np.ndarray) -> float:
+    from scipy.spatial import cKDTree
+
+    return float(np.median(cKDTree(points).query(points, k=2)[0][:, 1]))

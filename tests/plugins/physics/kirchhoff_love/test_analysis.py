@@ -91,3 +91,16 @@ def test_load_off_the_surface_and_empty_selector_are_errors():
     s = _settings(supports=[Support(kind="clamped", where=Selector(plane=[1, 0, 0, 7.0]))])
     with pytest.raises(InputError, match="select"):
         solve_linear(_model(s), s)
+
+
+def test_line_and_pressure_loads_total_their_resultants(solved):
+    from pointatlas_physics.kirchhoff_love.analysis import _quadrature_normals
+    from pointatlas_physics.kirchhoff_love.loads import line_load, surface_load
+
+    model, _ = solved
+    edge = Selector(plane=[1, 0, 0, 5.0])
+    f = line_load(model.atlas, model.points, model.boundary, model.curves, edge, [0, 0, -3.0])
+    assert f.sum(axis=0) == pytest.approx([0, 0, -3.0 * 5.0], rel=1e-8)  # 3 per length × 5
+    n = _quadrature_normals(model.quadrature, model.nodes)
+    f = surface_load(model.quadrature, model.nodes.shape[0], pressure=2.0, normals=n)
+    assert abs(f.sum(axis=0)[2]) == pytest.approx(2.0 * 25.0, rel=1e-8)

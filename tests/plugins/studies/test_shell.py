@@ -54,3 +54,24 @@ def test_convergence_rate_and_monotonicity():
     titles = [t for t, _ in convergence_figures(_sweep(dofs, 1.0 + errs))]
     assert "rate over the last three refinements: -1.00" in titles[0]
     assert len(titles) == 3
+
+
+def test_own_point_cloud_file_with_selectors_needs_no_code(tmp_path, run_cli):
+    import pointatlas
+
+    cloud = pointatlas.load_plugin("sources", "square_plate")(n_points=196, model="quarter") \
+        .load(np.random.default_rng(0))
+    np.savez(tmp_path / "plate.npz", points=cloud.points)
+    supports = ("[{kind:clamped,where:{expression:'x > 4.99'}},"
+                "{kind:clamped,where:{plane:[0,1,0,5.0]}},"
+                "{kind:symmetry,normal:[1,0,0],where:{plane:[1,0,0,0]}},"
+                "{kind:symmetry,normal:[0,1,0],where:{box:[-1,-0.01,-1,6,0.01,1]}}]")
+    r = run_cli("pointatlas", "~experiment", "source=file", f"source.path={tmp_path}/plate.npz",
+                "embedder=pca", "physics=kirchhoff_love", "study=shell",
+                "study.quadrature_order=4", f"physics.supports={supports}",
+                "physics.loads=[{kind:point,at:[0,0,0],force:[0,0,-50]}]",
+                "study.references=[1.2257045]", f"outputs_root={tmp_path}/out", "quiet=true",
+                cwd=tmp_path)
+    assert r.returncode == 0, r.stderr[-2000:]
+    ds = open_run(next((tmp_path / "out").glob("runs/*/*")))
+    assert float(ds["relative_error"]) < 0.01

@@ -8,6 +8,7 @@ control points J_κ ⊃ {a : ψ_κ(P_a) > tol}; integrals are ∫_M f ≈ Σ_κ 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from itertools import chain
 from typing import Callable, Optional
 
 import numpy as np
@@ -65,14 +66,40 @@ class Atlas:
     # -- construction ----------------------------------------------------------------
     def _control_set(self, members: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """J_κ and ψ_κ at its points: points where ψ_κ > tol_pu, grown by the margin."""
+        key = members.tobytes()
+        if key in self._control_sets:
+            return self._control_sets[key]
         psi_all = np.asarray(self.W_points_[:, members].sum(axis=1)).ravel()
         core = np.flatnonzero(psi_all > self.settings.tol_pu)
         if core.size == 0:
             core = np.unique(self.point_tree_.query(self.markers_[members], k=1)[1])
-        r = self.settings.chart_margin * self.h_points_
-        near = self.point_tree_.query_ball_point(self.points_[core], r)
-        J = np.unique(np.concatenate([core] + [np.asarray(n, dtype=np.int64) for n in near]))
+        indptr, indices = self._margin_neighbors()
+        starts, stops = indptr[core], indptr[core + 1]
+        counts = stops - starts
+        flat = np.repeat(starts - np.cumsum(counts) + counts, counts) + np.arange(counts.sum())
+        J = np.unique(np.concatenate([core, indices[flat]]))
+        self._control_sets[key] = (J, psi_all[J])
         return J, psi_all[J]
+
+    def _margin_neighbors(self) -> tuple[np.ndarray, np.ndarray]:
+        """Points within chart_margin·h of every point, as CSR (indptr, indices); built once."""
+        if self._margin_csr is None:
+            r = self.settings.chart_margin * self.h_points_
+            near = self.point_tree_.query_ball_point(self.points_, r)
+            counts = np.fromiter((len(n) for n in near), dtype=np.int64, count=len(near))
+            indptr = np.concatenate([[0], np.cumsum(counts)])
+            indices = np.fromiter(chain.from_iterable(near), dtype=np.int64,
+                                  count=int(indptr[-1]))
+            self._margin_csr = (indptr, indices)
+        return self._margin_csr
+
+    def _embedding(self, J: np.ndarray) -> np.ndarray:
+        """Ξ_κ = R_κ(P_J), computed once per control set (acceptance test and chart)."""
+        key = J.tobytes()
+        if key not in self._embeddings:
+            self._embeddings[key] = np.asarray(self.make_embedder().fit_transform(self.points_[J]),
+                                               dtype=np.float64)
+        return self._embeddings[key]
 
     def _acceptable(self, members: np.ndarray) -> bool:
         s = self.settings
@@ -81,7 +108,7 @@ class Atlas:
         J, _ = self._control_set(members)
         if J.size < 10:
             return True
-        xi = np.asarray(self.make_embedder().fit_transform(self.points_[J]))
+        xi = self._embedding(J)
         defects = embedding_defects(self.points_[J], xi)
         self.defects_[tuple(members[:3])] = defects
         return (defects["flip_fraction"] == 0.0 and defects["stress"] < s.max_stress
@@ -98,6 +125,7 @@ class Atlas:
                              "with the same D.")
         self.points_, self.markers_ = P, Q
         self.point_tree_ = cKDTree(P)
+        self._control_sets, self._embeddings, self._margin_csr = {}, {}, None
         self.h_points_ = float(np.median(self.point_tree_.query(P, k=2)[0][:, 1]))
         self.pu_ = self.make_pu().fit(Q)
         self.W_points_ = self.pu_.evaluate(P, order=0).to_csr(Q.shape[0]).tocsc()
@@ -117,8 +145,9 @@ class Atlas:
         for k in progress(range(L), total=L, desc="charts"):
             members = np.flatnonzero(self.labels_ == k)
             J, psi = self._control_set(members)
+            xi = self._embeddings.get(J.tobytes())
             self.charts_.append(build_chart(self.points_, J, self.make_embedder(), self.make_lme,
-                                            s.least_squares_fit))
+                                            s.least_squares_fit, xi=xi))
             self.support_.append(psi)
         return self.charts_
 

@@ -16,12 +16,121 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Callable
 
+import numba as nb
 import numpy as np
+from scipy.sparse import identity
 from scipy.sparse.linalg import splu
 from scipy.spatial import Delaunay
 
 from . import differential_geometry as dg
 from .quadrature import map_rule_to_simplices, simplex_rule
+
+
+@nb.njit(parallel=True, cache=True)
+def _combine_kernel(indptr, indices, values, grads, hess, C, order, X, T, S):
+    """X_i = Σ_q p_q C_{a_q}, T_iα = Σ_q ∂_α p_q C_{a_q}, S_iαβ = Σ_q ∂_αβ p_q C_{a_q} (CSR rows).
+
+    Sums run over each row in storage order, as scipy's CSR product does.
+    """
+    m = indptr.shape[0] - 1
+    D = C.shape[1]
+    d = grads.shape[1]
+    for i in nb.prange(m):
+        for q in range(indptr[i], indptr[i + 1]):
+            a = indices[q]
+            v = values[q]
+            for c in range(D):
+                cc = C[a, c]
+                X[i, c] += v * cc
+                if order >= 1:
+                    for k in range(d):
+                        T[i, k, c] += grads[q, k] * cc
+                if order >= 2:
+                    for k in range(d):
+                        for j in range(k, d):
+                            S[i, k, j, c] += hess[q, k, j] * cc
+        if order >= 2:
+            for k in range(d):
+                for j in range(k + 1, d):
+                    for c in range(D):
+                        S[i, j, k, c] = S[i, k, j, c]
+
+
+@nb.njit(parallel=True, cache=True)
+def _combine_surface_kernel(indptr, indices, values, grads, hess, C, X, T, S):
+    """:func:`_combine_kernel` for d = 2, D = 3, order 2 with the sums held in registers."""
+    m = indptr.shape[0] - 1
+    for i in nb.prange(m):
+        x0 = x1 = x2 = 0.0
+        t00 = t01 = t02 = t10 = t11 = t12 = 0.0
+        s000 = s001 = s002 = s010 = s011 = s012 = s110 = s111 = s112 = 0.0
+        for q in range(indptr[i], indptr[i + 1]):
+            a = indices[q]
+            v, g0, g1 = values[q], grads[q, 0], grads[q, 1]
+            h00, h01, h11 = hess[q, 0, 0], hess[q, 0, 1], hess[q, 1, 1]
+            c0, c1, c2 = C[a, 0], C[a, 1], C[a, 2]
+            x0 += v * c0
+            x1 += v * c1
+            x2 += v * c2
+            t00 += g0 * c0
+            t01 += g0 * c1
+            t02 += g0 * c2
+            t10 += g1 * c0
+            t11 += g1 * c1
+            t12 += g1 * c2
+            s000 += h00 * c0
+            s001 += h00 * c1
+            s002 += h00 * c2
+            s010 += h01 * c0
+            s011 += h01 * c1
+            s012 += h01 * c2
+            s110 += h11 * c0
+            s111 += h11 * c1
+            s112 += h11 * c2
+        X[i, 0], X[i, 1], X[i, 2] = x0, x1, x2
+        T[i, 0, 0], T[i, 0, 1], T[i, 0, 2] = t00, t01, t02
+        T[i, 1, 0], T[i, 1, 1], T[i, 1, 2] = t10, t11, t12
+        S[i, 0, 0, 0], S[i, 0, 0, 1], S[i, 0, 0, 2] = s000, s001, s002
+        S[i, 0, 1, 0], S[i, 0, 1, 1], S[i, 0, 1, 2] = s010, s011, s012
+        S[i, 1, 0, 0], S[i, 1, 0, 1], S[i, 1, 0, 2] = s010, s011, s012
+        S[i, 1, 1, 0], S[i, 1, 1, 1], S[i, 1, 1, 2] = s110, s111, s112
+
+
+#: below this many points the kernels run on one thread (a parallel region costs more)
+PARALLEL_MIN_POINTS = 4000
+
+
+def chart_derivatives(basis, control_points: np.ndarray, order: int = 2):
+    """φ = Σ_a p_a P_a, Dφ and D²φ (thesis Eq. 2) in one pass over the sparse basis.
+
+    Same result as :func:`differential_geometry.chart_derivatives` (X (m, D), T (m, d, D) or
+    None, S (m, d, d, D) or None) without building one scipy matrix per derivative.
+    """
+    C = np.ascontiguousarray(control_points, dtype=np.float64)
+    m, D = basis.n_points, C.shape[1]
+    d = basis.gradients.shape[1] if order >= 1 else 0
+    X = np.zeros((m, D))
+    T = np.zeros((m, d, D)) if order >= 1 else None
+    S = np.zeros((m, d, d, D)) if order >= 2 else None
+    args = (np.asarray(basis.indptr, np.int64), np.asarray(basis.indices, np.int64),
+            np.ascontiguousarray(basis.values, np.float64))
+    threads = nb.get_num_threads()
+    if m < PARALLEL_MIN_POINTS:
+        nb.set_num_threads(1)
+    try:
+        if order == 2 and d == 2 and D == 3:
+            _combine_surface_kernel(*args, np.ascontiguousarray(basis.gradients),
+                                    np.ascontiguousarray(basis.hessians), C, X, T, S)
+        else:
+            _combine_kernel(
+                *args,
+                np.ascontiguousarray(basis.gradients) if order >= 1 else np.zeros((0, 1)),
+                np.ascontiguousarray(basis.hessians) if order >= 2 else np.zeros((0, 1, 1)),
+                C, int(order), X, T if T is not None else np.zeros((0, 1, D)),
+                S if S is not None else np.zeros((0, 1, 1, D)))
+    finally:
+        nb.set_num_threads(threads)
+    return X, T, S
 
 
 @dataclass
@@ -53,7 +162,7 @@ class Chart:
     def evaluate(self, xi: np.ndarray, order: int = 2):
         """(φ, Dφ, D²φ, outside) at parametric points; rows where ``outside`` are zero."""
         basis = self.approximant.evaluate(xi, order=order)
-        X, T, S = dg.chart_derivatives(basis, self.control_points, order)
+        X, T, S = chart_derivatives(basis, self.control_points, order)
         outside = basis.outside if basis.outside is not None else np.zeros(len(xi), bool)
         return X, T, S, outside
 
@@ -66,37 +175,72 @@ class Chart:
 
 
 def build_chart(points: np.ndarray, node_index: np.ndarray, embedder, make_approximant:
-                Callable[[], object], least_squares_fit: bool) -> Chart:
-    """Embed the control points J_κ and build the LME chart on them."""
+                Callable[[], object], least_squares_fit: bool,
+                xi: np.ndarray | None = None) -> Chart:
+    """Embed the control points J_κ (unless their embedding ``xi`` is given) and build the
+    LME chart on them."""
     P = points[node_index]
-    xi = np.asarray(embedder.fit_transform(P), dtype=np.float64)
+    if xi is None:
+        xi = embedder.fit_transform(P)
+    xi = np.asarray(xi, dtype=np.float64)
     lme = make_approximant().fit(xi)
+    basis = lme.evaluate(xi, order=0)
     C = P
     if least_squares_fit:
-        C = interpolating_control_points(lme, xi, P)
-    basis = lme.evaluate(xi, order=0)
-    X, _, _ = dg.chart_derivatives(basis, C, 0)
+        C = interpolating_control_points(lme, xi, P, basis)
+    X, _, _ = chart_derivatives(basis, C, 0)
     ok = np.ones(len(P), bool) if basis.outside is None else ~basis.outside
     resid = float(np.max(np.linalg.norm(X - P, axis=1)[ok], initial=0.0))
     return Chart(node_index, xi, C, lme, resid)
 
 
-def interpolating_control_points(lme, xi: np.ndarray, samples: np.ndarray) -> np.ndarray:
+#: charts with at most this many control points solve the interpolation system densely
+DENSE_SOLVE_MAX = 2000
+_blas_controller = None
+
+
+def _one_blas_thread():
+    """Context limiting BLAS to one thread (the controller scans the libraries once)."""
+    global _blas_controller
+    from threadpoolctl import ThreadpoolController
+
+    if _blas_controller is None:
+        _blas_controller = ThreadpoolController()
+    return _blas_controller.limit(limits=1, user_api="blas")
+
+
+def interpolating_control_points(lme, xi: np.ndarray, samples: np.ndarray,
+                                 basis=None) -> np.ndarray:
     """Control points C with Σ_b p_b(ξ_a) C_b = x_a at every node (Paper 2 App. B, per chart).
 
     The normal equations MᵀM C = Mᵀ X of App. B with as many samples as control points
     reduce to M C = X, M_ab = p_b(ξ_a) (sparse, diagonally dominant for γ ≳ 0.5).
+    ``basis``: the LME basis at the nodes ξ, if already evaluated.
     """
-    from scipy.sparse import identity
-
     n = xi.shape[0]
-    basis = lme.evaluate(xi, order=0)
+    if basis is None:
+        basis = lme.evaluate(xi, order=0)
     M = basis.to_csr(n)
     if basis.outside is not None and basis.outside.any():
         # nodes where the LME dual fails (on the hull boundary, where p_a → δ_ab): keep C_a = x_a
         fix = identity(n, format="csr").multiply(basis.outside[:, None].astype(float))
         M = M + fix
+    if n <= DENSE_SOLVE_MAX:
+        # a few hundred nodes with ~80 non-zeros a row: one-thread LAPACK LU is ~7x faster
+        # than SuperLU (and threaded BLAS only fights the numba threads at this size)
+        with _one_blas_thread():
+            return np.linalg.solve(M.toarray(), samples)
     return splu(M.tocsc()).solve(samples)
+
+
+def area_element(T: np.ndarray) -> np.ndarray:
+    """J = sqrt(det a), a_αβ = φ_α·φ_β (thesis §3.4); explicit 2×2 determinant for d = 2."""
+    if T.shape[1] != 2:
+        return dg.area_element(T)
+    a00 = np.einsum("mi,mi->m", T[:, 0], T[:, 0])
+    a11 = np.einsum("mi,mi->m", T[:, 1], T[:, 1])
+    a01 = np.einsum("mi,mi->m", T[:, 0], T[:, 1])
+    return np.sqrt(np.clip(a00 * a11 - a01 * a01, 0.0, None))
 
 
 def chart_quadrature(chart: Chart, support_at_nodes: np.ndarray, patch_pu: Callable,
@@ -127,7 +271,7 @@ def chart_quadrature(chart: Chart, support_at_nodes: np.ndarray, patch_pu: Calla
     xg, wg = map_rule_to_simplices(xi[simplices], rule)
     n_candidates = len(wg)
     basis = chart.approximant.evaluate(xg, order=2 if need_second else 1)
-    X, T, S = dg.chart_derivatives(basis, chart.control_points, 2 if need_second else 1)
+    X, T, S = chart_derivatives(basis, chart.control_points, 2 if need_second else 1)
     outside = basis.outside if basis.outside is not None else np.zeros(len(xg), bool)
     lost = 0.0
     if outside.any():  # diagnostic: ψ_κ at the control point nearest to each dropped point
@@ -136,10 +280,11 @@ def chart_quadrature(chart: Chart, support_at_nodes: np.ndarray, patch_pu: Calla
         _, j = cKDTree(xi).query(xg[outside], k=1)
         lost = float(np.max(patch_pu(chart.control_points[j]), initial=0.0))
     inside = ~outside
-    xg, wg, X, T = xg[inside], wg[inside], X[inside], T[inside]
-    S = None if S is None else S[inside]
+    if outside.any():
+        xg, wg, X, T = xg[inside], wg[inside], X[inside], T[inside]
+        S = None if S is None else S[inside]
     psi = patch_pu(X)
-    J = dg.area_element(T)
+    J = area_element(T)
     use = psi > tol_pu
     kept = None
     if keep_basis:

@@ -34,6 +34,22 @@ def knn_graph(points: np.ndarray, n_neighbors: int) -> csr_matrix:
     return A.tocsr()
 
 
+def knn_edges(points: np.ndarray, n_neighbors: int) -> tuple[np.ndarray, np.ndarray]:
+    """(row, col) of the symmetrised k-NN graph's edges, both directions, sorted row-major:
+    the non-zeros of :func:`knn_graph` in CSR/COO order, without building the matrix."""
+    n = points.shape[0]
+    k = min(int(n_neighbors), n - 1)
+    if k < 1:
+        raise InputError(f"a neighbour graph needs at least 2 points; got {n}.")
+    _, nb = cKDTree(points).query(points, k=k + 1)
+    rows = np.repeat(np.arange(n, dtype=np.int64), k)
+    cols = nb[:, 1:].ravel().astype(np.int64)
+    code = np.unique(np.concatenate([rows * n + cols, cols * n + rows]))
+    row, col = np.divmod(code, n)
+    off = row != col
+    return row[off], col[off]
+
+
 def metis_parts(adjacency: csr_matrix, n_parts: int) -> np.ndarray:
     """Labels (n,) of a METIS k-way partition of the graph into n_parts parts."""
     import pymetis
@@ -117,9 +133,9 @@ def embedding_defects(points: np.ndarray, xi: np.ndarray, n_neighbors: int = 8
     - ``max_distortion`` / ``distortion``: largest / 95th-percentile ratio of singular values of
       the affine map ξ → P over the non-sliver triangles (edges < 3 median k-NN distances).
     """
-    A = knn_graph(points, n_neighbors).tocoo()
-    dx = np.linalg.norm(points[A.row] - points[A.col], axis=1)
-    dxi = np.linalg.norm(xi[A.row] - xi[A.col], axis=1)
+    row, col = knn_edges(points, n_neighbors)
+    dx = np.linalg.norm(points[row] - points[col], axis=1)
+    dxi = np.linalg.norm(xi[row] - xi[col], axis=1)
     out = {"stress": float(np.sum((dxi - dx) ** 2) / np.sum(dx**2))}
     if xi.shape[1] != 2 or points.shape[1] != 3 or len(xi) < 4:
         r = float(np.max(dxi / dx) / np.min(dxi / dx))
@@ -139,11 +155,13 @@ def embedding_defects(points: np.ndarray, xi: np.ndarray, n_neighbors: int = 8
     good = (edge < 3.0 * np.median(dx)) & (shape_quality > 0.2)
     normal = np.cross(P1 - P0, P2 - P0)
     normal /= np.linalg.norm(normal, axis=1, keepdims=True) + 1e-300
-    nbr = tri.neighbors
-    pairs = [(t, s) for t in np.flatnonzero(good) for s in nbr[t] if s > t and good[s]]
-    if pairs:
-        pa = np.array(pairs)
-        out["flip_fraction"] = float(np.mean(np.sum(normal[pa[:, 0]] * normal[pa[:, 1]], 1) < 0))
+    # pairs (t, s) of adjacent good triangles, s > t (s = -1: no neighbour)
+    t_idx = np.repeat(np.arange(len(S)), tri.neighbors.shape[1])
+    s_idx = tri.neighbors.ravel()
+    pair = (s_idx > t_idx) & good[t_idx] & good[np.maximum(s_idx, 0)]
+    if pair.any():
+        ta, sa = t_idx[pair], s_idx[pair]
+        out["flip_fraction"] = float(np.mean(np.sum(normal[ta] * normal[sa], 1) < 0))
     else:
         out["flip_fraction"] = 0.0
     # affine map ξ → P on each good triangle: P_e = F ξ_e with F (3, 2)

@@ -94,7 +94,10 @@ def map_rule_to_simplices(vertices: np.ndarray, rule: SimplexRule) -> tuple[np.n
     """
     V = np.asarray(vertices, dtype=np.float64)
     E = V[:, 1:, :] - V[:, :1, :]  # (s, d, d): rows are edge vectors
-    det = np.abs(np.linalg.det(E))
+    if E.shape[1] == 2:  # explicit 2×2 determinant (np.linalg.det loops in LAPACK per simplex)
+        det = np.abs(E[:, 0, 0] * E[:, 1, 1] - E[:, 0, 1] * E[:, 1, 0])
+    else:
+        det = np.abs(np.linalg.det(E))
     pts = V[:, None, 0, :] + np.einsum("gk,skj->sgj", rule.points, E)
     w = det[:, None] * rule.weights[None, :]
     return pts.reshape(-1, V.shape[2]), w.ravel()

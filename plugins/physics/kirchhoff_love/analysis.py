@@ -120,9 +120,7 @@ def solve_linear(model: ShellModel, settings, log=None) -> ShellModel:
     """Stiffness, loads, supports and the augmented-Lagrangian solve; fills ``model``."""
     from pointatlas_atlas.evaluation import basis_at_nodes
 
-    from .constraints import check_rigid_motions, support_constraints
     from .linear import linear_stiffness
-    from .loads import line_load, point_load, surface_load
     from .solver import solve_augmented
 
     t = model.times
@@ -130,27 +128,9 @@ def solve_linear(model: ShellModel, settings, log=None) -> ShellModel:
     with _timed(t, "assembly"):
         K = regularize_ghosts(linear_stiffness(model.quadrature, model.material), model)
     with _timed(t, "loads"):
-        F = np.zeros((N_all, 3))
-        normals = None
-        for ld in settings.loads:
-            if ld.kind == "point":
-                f, where, dist = point_load(model.atlas, ld.at, ld.force, model.spacing,
-                                            settings.max_load_offset)
-                if log is not None:
-                    log.info("point load %s at %s (projected %.3g away)", list(ld.force),
-                             np.round(where, 6).tolist(), dist)
-                F += f
-            elif ld.kind in ("surface", "pressure"):
-                if ld.kind == "pressure" and normals is None:
-                    normals = _quadrature_normals(model.quadrature, model.nodes)
-                F += surface_load(model.quadrature, N_all, ld.force, ld.pressure, normals)
-            else:
-                F += line_load(model.atlas, model.points, model.boundary, model.curves,
-                               ld.where, ld.force)
+        F = assemble_loads(model, settings, log)
     with _timed(t, "constraints"):
-        cons = support_constraints(model.atlas, model.points, model.boundary, model.curves,
-                                   settings.supports, model.spacing, settings.segment_points)
-        check_rigid_motions(cons.matrix, model.nodes, settings.supports)
+        cons = assemble_supports(model, settings)
     with _timed(t, "solve"):
         U, _, info = solve_augmented(K, F.ravel(), cons.matrix, cons.rhs, settings.penalty,
                                      settings.constraint_tol, method=settings.solver)
@@ -164,6 +144,40 @@ def solve_linear(model: ShellModel, settings, log=None) -> ShellModel:
     model.stiffness, model.forces, model.constraints = K, F, cons
     model.nodal_displacement, model.displacement, model.solve_info = U, u, info
     return model
+
+
+def assemble_loads(model: ShellModel, settings, log=None) -> np.ndarray:
+    """Nodal forces (N + G, 3) of all configured loads at load factor 1."""
+    from .loads import line_load, point_load, surface_load
+
+    F = np.zeros((model.nodes.shape[0], 3))
+    normals = None
+    for ld in settings.loads:
+        if ld.kind == "point":
+            f, where, dist = point_load(model.atlas, ld.at, ld.force, model.spacing,
+                                        settings.max_load_offset)
+            if log is not None:
+                log.info("point load %s at %s (projected %.3g away)", list(ld.force),
+                         np.round(where, 6).tolist(), dist)
+            F += f
+        elif ld.kind in ("surface", "pressure"):
+            if ld.kind == "pressure" and normals is None:
+                normals = _quadrature_normals(model.quadrature, model.nodes)
+            F += surface_load(model.quadrature, F.shape[0], ld.force, ld.pressure, normals)
+        else:
+            F += line_load(model.atlas, model.points, model.boundary, model.curves,
+                           ld.where, ld.force)
+    return F
+
+
+def assemble_supports(model: ShellModel, settings):
+    """Constraints C U = g of the supports, checked against unheld rigid motions."""
+    from .constraints import check_rigid_motions, support_constraints
+
+    cons = support_constraints(model.atlas, model.points, model.boundary, model.curves,
+                               settings.supports, model.spacing, settings.segment_points)
+    check_rigid_motions(cons.matrix, model.nodes, settings.supports)
+    return cons
 
 
 def regularize_ghosts(K, model: ShellModel, eps: float = 1e-10):

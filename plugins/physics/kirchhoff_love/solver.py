@@ -26,6 +26,7 @@ class SolveInfo:
     violation: float           # max |CU − g| at the end (length units)
     rho: float
     times: dict = field(default_factory=dict)
+    negative_pivots: int = -1  # of K + ρCᵀC (direct solver): > 0 means an unstable state
 
 
 def factorize(A: csr_matrix, method: str = "direct"):
@@ -47,7 +48,12 @@ def factorize(A: csr_matrix, method: str = "direct"):
             raise InputError("the constrained stiffness matrix is singular: some motion of the "
                              "shell is not prevented by the supports, or the point cloud is too "
                              "sparse for the chart support. Add supports or more points.")
-        return lu.solve
+
+        def direct(b):
+            return lu.solve(b)
+        # without pivoting, the signs of U's diagonal are those of D in A = LDLᵀ (inertia)
+        direct.negative_pivots = int((lu.U.diagonal() < 0).sum())
+        return direct
     ilu = spilu(A, drop_tol=1e-5, fill_factor=20)
     M = LinearOperator(A.shape, ilu.solve)
 
@@ -98,4 +104,7 @@ def solve_augmented(K: csr_matrix, F: np.ndarray, C: csr_matrix, g: np.ndarray,
         raise InputError("the solve produced NaN/inf: the problem is singular or badly scaled. "
                          "Check the supports and that moduli and thickness are positive.")
     t2 = time.perf_counter()
-    return U, lam, SolveInfo(max(it, 1), viol, rho, {"factorize": t1 - t0, "iterate": t2 - t1})
+    # the multiplier of the augmented Lagrangian is λ + ρ(CU − g) (reaction forces −Cᵀμ)
+    lam = lam + rho * (C @ U - g)
+    return U, lam, SolveInfo(max(it, 1), viol, rho, {"factorize": t1 - t0, "iterate": t2 - t1},
+                             getattr(solve, "negative_pivots", -1))

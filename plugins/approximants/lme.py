@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import ClassVar, Optional
 
+import numba
 import numpy as np
 from scipy.spatial import cKDTree
 
@@ -106,6 +107,9 @@ class LocalMaxEnt:
         self.radius_ = support_radius(self.beta_, float(self.tol))
         self.grid_ = SupportGrid(X, self.radius_)
         self.h_ref_ = float(np.median(self.spacing_))
+        # β of every cell-list entry, contiguous for the kernel (None on the kd-tree path)
+        entries = getattr(self.grid_, "entries", None)
+        self.entry_beta_ = None if entries is None else self.beta_[entries]
         return self
 
     @property
@@ -170,8 +174,17 @@ class LocalMaxEnt:
         grads = np.empty((nnz if order >= 1 else 0, d))
         hess = np.empty((nnz if order >= 2 else 0, d, d))
         status = np.empty(len(cells.points), dtype=np.int64)
-        K.lme_kernel(*cells.args(), self.beta_, indptr, float(self.newton_tol) * self.h_ref_,
-                     int(self.max_iter), order, indices, values, grads, hess, status)
+        entry_beta = (self.entry_beta_ if cells.entries is getattr(self.grid_, "entries", None)
+                      else self.beta_[cells.entries])
+        # dynamic scheduling (chunks of 4 × 64 points): the per-point cost varies and the
+        # cores may be shared, so a static split would leave a thread waiting
+        previous = numba.set_parallel_chunksize(4)
+        try:
+            K.lme_kernel(*cells.args(), entry_beta, indptr,
+                         float(self.newton_tol) * self.h_ref_, int(self.max_iter), order,
+                         indices, values, grads, hess, status)
+        finally:
+            numba.set_parallel_chunksize(previous)
         arrays = [indices, values, grads if order >= 1 else None, hess if order >= 2 else None]
         return indptr, arrays, status
 

@@ -27,7 +27,8 @@ import numpy as np
 
 from .small_math import FAST as _FAST
 from .small_math import cholesky, cholesky_solve, exp_nonpositive
-from .support import scan
+from .lme_hessian_2d import hessians_2d
+from .lme_last_step import SMALL_EXPONENT_STEP, small_step_converges
 
 #: initial largest change of any exponent f_a in one Newton step (the cap then adapts)
 MAX_EXPONENT_STEP = 20.0
@@ -88,8 +89,9 @@ def solve_dual(yT, beta, d2, k, tol, max_iter, lam, p, mats, vecs, ib):
     a cap that starts at MAX_EXPONENT_STEP and doubles after full capped steps), halved until
     log Z decreases (Armijo, with round-off slack); each trial costs one pass of exponentials,
     reused by the next iteration when accepted. Where J is singular the step is steepest
-    descent, -r. No convergence within ``max_iter`` or a non-finite log Z means the point is
-    outside the convex hull of its support nodes (the dual has no minimiser).
+    descent, -r. The last, tiny step updates the weights without exponentials
+    (:mod:`.lme_last_step`). No convergence within ``max_iter`` or a non-finite log Z means the
+    point is outside the convex hull of its support nodes (the dual has no minimiser).
     """
     d = yT.shape[0]
     if k <= d:
@@ -152,6 +154,11 @@ def solve_dual(yT, beta, d2, k, tol, max_iter, lam, p, mats, vecs, ib):
                 capped = True
                 for i in range(d):
                     step[i] *= cap / smax
+        if not capped and np.sqrt(sn) * ymax < SMALL_EXPONENT_STEP:
+            if small_step_converges(yT, k, step, p, tol):  # the last step: no exponentials
+                for i in range(d):
+                    lam[i] += step[i]
+                return OK
         slope = 0.0
         for i in range(d):
             slope += r[i] * step[i]
@@ -248,6 +255,9 @@ def derivatives(yT, beta, p, k, order, lo, grads, hess, gT, jT, hT, mats, vecs, 
             grads[lo + a, i] = p[a] * gi[a]
     if order < 2:
         return True
+    if d == 2:
+        hessians_2d(yT, beta, p, gT, Jinv, bbar, k, lo, hess)
+        return True
     G = mats[1]  # J_β no longer needed (row views below keep the inner loops vectorisable)
     for i in range(d):
         gi = gT[i]
@@ -303,11 +313,12 @@ def derivatives(yT, beta, p, k, order, lo, grads, hess, gT, jT, hT, mats, vecs, 
 
 
 @nb.njit(parallel=True, cache=True)
-def lme_kernel(points, visit, cell, starts, entries, entry_x, entry_r2, beta, indptr, tol,
-               max_iter, order, indices, values, grads, hess, status):
+def lme_kernel(points, visit, cell, starts, entries, entry_x, entry_r2, entry_beta, indptr,
+               tol, max_iter, order, indices, values, grads, hess, status):
     """LME values (and derivatives up to ``order``) at all points, in CSR layout, in parallel.
 
-    The first seven arguments are :meth:`support.Cells.args`; ``indptr`` comes from
+    The first seven arguments are :meth:`support.Cells.args`, ``entry_beta`` is β of each
+    entry (``beta[entries]``, contiguous like ``entry_r2``); ``indptr`` comes from
     :meth:`support.Cells.count`; the kernel fills ``indices`` (support nodes), ``values``,
     ``grads`` ((nnz, d), if order ≥ 1) and ``hess`` ((nnz, d, d), if order 2).
     ``status[i]`` receives OK, NO_SUPPORT or NOT_CONVERGED. Points are processed in the order
@@ -320,14 +331,19 @@ def lme_kernel(points, visit, cell, starts, entries, entry_x, entry_r2, beta, in
         i0 = c * chunk
         i1 = min(m, i0 + chunk)
         kmax = 0
+        cmax = 0  # most candidates in a cell: the scan writes every candidate, then keeps k
         for ii in range(i0, i1):
             kmax = max(kmax, indptr[visit[ii] + 1] - indptr[visit[ii]])
-        yT = np.empty((d, kmax))
+            ci = cell[visit[ii]]
+            if ci >= 0:
+                cmax = max(cmax, starts[ci + 1] - starts[ci])
+        yT = np.empty((d, cmax))
+        ent = np.empty(cmax, dtype=np.int64)
         gT = np.empty((d, kmax))
         jT = np.empty((d, kmax))
         hT = np.empty((d, d, kmax) if order >= 2 else (d, d, 0))
-        bl = np.empty(kmax)
-        d2 = np.empty(kmax)
+        bl = np.empty(cmax)
+        d2 = np.empty(cmax)
         mats = np.empty((5, d, d))
         vecs = np.empty((4, d))
         S = np.empty((d, d, d))
@@ -338,18 +354,23 @@ def lme_kernel(points, visit, cell, starts, entries, entry_x, entry_r2, beta, in
             i = visit[ii]
             lo = indptr[i]
             k = indptr[i + 1] - lo
-            scan(points[i], cell[i], starts, entries, entry_x, entry_r2, indices, lo, True)
+            ci = cell[i]
+            if ci >= 0:
+                # branch-free scan of the cell: store every candidate at slot q, advance q
+                # only for support nodes (|x - x_a|² < r_a²); same order as support.scan
+                q = 0
+                for e in range(starts[ci], starts[ci + 1]):
+                    s = 0.0
+                    for j in range(d):
+                        t = points[i, j] - entry_x[j, e]
+                        yT[j, q] = t
+                        s += t * t
+                    d2[q] = s
+                    bl[q] = entry_beta[e]
+                    ent[q] = e
+                    q += 1 if s < entry_r2[e] else 0
             for q in range(k):
-                e = indices[lo + q]
-                a = entries[e]
-                indices[lo + q] = a
-                bl[q] = beta[a]
-                s = 0.0
-                for j in range(d):
-                    t = points[i, j] - entry_x[j, e]
-                    yT[j, q] = t
-                    s += t * t
-                d2[q] = s
+                indices[lo + q] = entries[ent[q]]
             lam[:] = 0.0
             st = solve_dual(yT, bl, d2, k, tol, max_iter, lam, p, mats, vecs, ib)
             status[i] = st

@@ -25,21 +25,31 @@ class KirchhoffLove:
     def settings(self) -> ShellSettings:
         return ShellSettings(**{k: getattr(self, k) for k in ShellSettings.__dataclass_fields__})
 
+    def shell_settings(self) -> ShellSettings:
+        """The settings with supports, loads and selectors as dataclasses, checked."""
+        s = _as_settings(self.settings())
+        check_settings(s)
+        return s
+
+    @staticmethod
+    def factories(ctx, atlas_settings) -> dict:
+        """make_embedder / make_lme / make_pu for :func:`.analysis.build_model`."""
+        a = atlas_settings
+        return dict(
+            make_embedder=lambda: ctx.plugin("embedder"),
+            make_lme=lambda: ctx.make("approximants", "lme", gamma=a.gamma_lme, tol=a.tol_lme,
+                                      outside="flag"),
+            make_pu=lambda: ctx.make("approximants", "shepard", gamma=a.gamma_pu, tol=a.tol_pu,
+                                     outside="flag"))
+
     def solve(self, ctx, *, cloud, atlas_settings):
         """Linear analysis of ``cloud``; returns displacement, forces and sizes (xr.Dataset)."""
         from .analysis import build_model, solve_linear
         from .results import field_dataset
 
-        s = _as_settings(self.settings())
-        check_settings(s)
-        model = build_model(
-            cloud, s, atlas_settings,
-            make_embedder=lambda: ctx.plugin("embedder"),
-            make_lme=lambda: ctx.make("approximants", "lme", gamma=atlas_settings.gamma_lme,
-                                      tol=atlas_settings.tol_lme, outside="flag"),
-            make_pu=lambda: ctx.make("approximants", "shepard", gamma=atlas_settings.gamma_pu,
-                                     tol=atlas_settings.tol_pu, outside="flag"),
-            log=ctx.log)
+        s = self.shell_settings()
+        model = build_model(cloud, s, atlas_settings, **self.factories(ctx, atlas_settings),
+                            log=ctx.log)
         solve_linear(model, s, log=ctx.log)
         self.model_ = model
         return field_dataset(model)

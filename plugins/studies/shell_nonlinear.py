@@ -1,0 +1,223 @@
+"""Geometrically nonlinear shell analysis along a load path (thesis §4.4, Paper 2 §4–5).
+
+The ``kirchhoff_love`` plugin builds the atlas, loads and supports; this study follows the
+load path under force control (:mod:`pointatlas_physics.kirchhoff_love.incremental`) and
+records, along a dim ``increment``: ``load_factor``, ``load`` (= load_factor × ``full_load``),
+the monitored displacements (``monitor_variable`` with dims (increment, point), point named
+by ``monitor_names``), the energy split, Newton iterations and the displacement field. After
+every converged increment ``increments.nc`` in the run directory is rewritten (atomically), so
+an interrupted run keeps its converged increments; ``resume_from`` (a run directory) restarts
+from the last increment stored there. Published curves (``reference_load_factors`` ×
+``reference_values``, one row per monitored point) give ``max_relative_error``.
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import ClassVar, List, Optional
+
+import numpy as np
+
+from pointatlas.stores_config import stores_config
+
+from .shell import ShellStudySettings
+
+
+@dataclass
+class ShellPathSettings(ShellStudySettings):
+    n_increments: int = 20
+    max_load_factor: float = 1.0
+    max_newton: int = 15
+    newton_tol: float = 1e-8
+    full_load: float = 1.0              # the applied force at load factor 1 (for ``load``)
+    monitor_points: List[float] = field(default_factory=list)       # x, y, z per point
+    monitor_directions: List[float] = field(default_factory=list)   # unit vector per point
+    monitor_names: List[str] = field(default_factory=list)
+    monitor_variable: str = "displacement_at"
+    monitor_magnitude: bool = False     # report |u·e| (magnitudes) instead of u·e
+    reference_load_factors: List[float] = field(default_factory=list)
+    reference_values: List[float] = field(default_factory=list)     # row per monitored point
+    reference_label: str = ""
+    resume_from: Optional[str] = None
+
+
+@stores_config
+class ShellNonlinearStudy:
+    """Follow a shell's load path with Newton and step cutting; monitor points; compare."""
+
+    Config = ShellPathSettings
+    description: ClassVar[str] = (
+        "Geometrically nonlinear Kirchhoff–Love shell along a load path (force control, "
+        "Newton, step cutting, stability by pivot signs); load–deflection curves.")
+
+    def atlas_settings(self):
+        from pointatlas_atlas.settings import AtlasSettings
+
+        return AtlasSettings(**{k: getattr(self, k) for k in AtlasSettings.__dataclass_fields__})
+
+    def _monitors(self):
+        from pointatlas.errors import ConfigError
+
+        P = np.asarray(self.monitor_points, dtype=float).reshape(-1, 3)
+        E = np.asarray(self.monitor_directions, dtype=float).reshape(-1, 3)
+        names = list(self.monitor_names)
+        if not (len(P) == len(E) == len(names)) or len(P) == 0:
+            raise ConfigError("study.monitor_points, monitor_directions (3 numbers per point) "
+                              "and monitor_names must describe the same ≥ 1 points.")
+        return P, E / np.linalg.norm(E, axis=1)[:, None], names
+
+    def run(self, ctx):
+        from pointatlas_physics.kirchhoff_love.analysis import (assemble_loads,
+                                                                 assemble_supports,
+                                                                 build_model)
+        from pointatlas_physics.kirchhoff_love.incremental import PathSettings, follow_path
+
+        from pointatlas.errors import ConfigError
+
+        if ctx.plugin_name("physics") != "kirchhoff_love":
+            raise ConfigError("study=shell_nonlinear needs physics=kirchhoff_love.")
+        P, E, names = self._monitors()
+        atlas_settings = self.atlas_settings()
+        atlas_settings.check()
+        with ctx.timed("source"):
+            cloud = ctx.plugin("source").load(ctx.rng("source"))
+        physics = ctx.plugin("physics")
+        s = physics.shell_settings()
+        with ctx.timed("model"):
+            model = build_model(cloud, s, atlas_settings, **physics.factories(ctx, atlas_settings),
+                                log=ctx.log)
+            F = assemble_loads(model, s, ctx.log)
+            cons = assemble_supports(model, s)
+        start = self._resume(model) if self.resume_from else None
+        records = [] if start is None else [start]
+        path = PathSettings(self.n_increments, self.max_load_factor, self.max_newton,
+                            self.newton_tol)
+
+        def keep(inc):
+            records.append(inc)
+            ctx.log.info("increment %d: λ = %.5g, %d Newton iterations, %s; %s", len(records),
+                         inc.load_factor, inc.iterations, "stable" if inc.stable else "UNSTABLE",
+                         ", ".join(f"{n} = {v:.5g}" for n, v in
+                                   zip(names, self._monitor_values(model, P, E, inc.U))))
+            self._write(ctx.run_dir / "increments.nc", model, records, P, E, names)
+
+        from pointatlas_physics.kirchhoff_love.incremental import PathFollowingError
+
+        stopped = ""
+        with ctx.timed("path"):
+            try:
+                follow_path(model, s, path, F, cons, keep, ctx.log, start=start)
+            except PathFollowingError as exc:
+                stopped = str(exc)
+                ctx.log.error("%s", exc)
+        ds = self._dataset(model, records, P, E, names)
+        ds.attrs["stopped"] = stopped or "completed the load path"
+        return ds
+
+    def _resume(self, model):
+        import xarray as xr
+        from pointatlas_physics.kirchhoff_love.incremental import Increment
+
+        path = Path(self.resume_from) / "increments.nc"
+        with xr.open_dataset(path) as old:
+            U = old["nodal_displacement"].isel(increment=-1).values
+            lam = float(old["load_factor"].isel(increment=-1))
+        if U.shape != model.nodes.shape:
+            from pointatlas.errors import InputError
+
+            raise InputError(f"{path} holds {U.shape[0]} nodes but this model has "
+                             f"{model.nodes.shape[0]}: resume with the same source and settings.")
+        return Increment(lam, U, 0, [], {}, -1, True, 0.0)
+
+    @staticmethod
+    def _monitor_values(model, P, E, U):
+        from pointatlas_physics.kirchhoff_love.analysis import displacement_at
+
+        saved = model.nodal_displacement
+        model.nodal_displacement = U
+        vals = np.array([float(displacement_at(model, p)[0] @ e) for p, e in zip(P, E)])
+        model.nodal_displacement = saved
+        return vals
+
+    def _dataset(self, model, records, P, E, names):
+        import xarray as xr
+
+        mon = np.array([self._monitor_values(model, P, E, r.U) for r in records]).reshape(
+            len(records), len(names))
+        if self.monitor_magnitude:
+            mon = np.abs(mon)
+        lam = np.array([r.load_factor for r in records])
+        one = {"units": "1"}
+        data = {
+            "load_factor": (("increment",), lam, {**one, "long_name": "load factor λ"}),
+            "load": (("increment",), lam * self.full_load, {
+                "long_name": "applied force λ·full_load", "units": "force"}),
+            self.monitor_variable: (("increment", "point"), mon, {
+                "long_name": "displacement at the monitored point along its direction"
+                             + (" (magnitude)" if self.monitor_magnitude else ""),
+                "units": "length"}),
+            "newton_iterations": (("increment",), [r.iterations for r in records], {
+                **one, "long_name": "Newton iterations"}),
+            "stable": (("increment",), np.array([r.stable for r in records], np.int8), {
+                **one, "long_name": "1 if no negative pivot of the constrained tangent"}),
+            "increment_time": (("increment",), [r.seconds for r in records], {
+                "long_name": "wall time of the increment", "units": "s"}),
+            "dof": ((), model.dof, {**one, "long_name": "degrees of freedom"}),
+        }
+        for part in ("membrane", "bending", "total"):
+            data[f"energy_{part}"] = (("increment",), [r.energy.get(part, np.nan)
+                                                       for r in records],
+                                      {"long_name": f"{part} strain energy", "units": "energy"})
+        ds = xr.Dataset(data, coords={
+            "increment": ("increment", np.arange(len(records)), {**one,
+                                                                 "long_name": "increment"}),
+            "point": ("point", names, {**one, "long_name": "monitored point"})})
+        if self.reference_load_factors and len(records):
+            ref = np.asarray(self.reference_values, float).reshape(len(names), -1)
+            lf = np.asarray(self.reference_load_factors, float)
+            ours = np.array([np.interp(lf, lam, mon[:, j], left=np.nan, right=np.nan)
+                             for j in range(len(names))])
+            err = np.abs(ours - ref) / np.abs(ref)
+            ds = ds.assign_coords(reference_level=("reference_level", lf, {
+                **one, "long_name": "tabulated load factor"}))
+            ds["reference_curve"] = (("point", "reference_level"), ref, {
+                "long_name": f"published values ({self.reference_label})", "units": "length"})
+            ds["relative_error_curve"] = (("point", "reference_level"), err, {
+                **one, "long_name": "|ours − published| / |published| at tabulated levels"})
+            ds["max_relative_error"] = ((), float(np.nanmax(err)) if np.isfinite(err).any()
+                                        else np.nan, {**one, "long_name":
+                                                      "largest relative error over the table"})
+        return ds
+
+    def _write(self, path: Path, model, records, P, E, names):
+        """increments.nc with all converged increments (temporary file, then rename)."""
+        ds = self._dataset(model, records, P, E, names)
+        ds["nodal_displacement"] = (("increment", "node", "dim"),
+                                    np.stack([r.U for r in records]),
+                                    {"long_name": "nodal displacements U (ghosts included)",
+                                     "units": "length"})
+        tmp = path.with_name(path.stem + ".partial.nc")
+        ds.to_netcdf(tmp)
+        os.replace(tmp, path)
+
+    @staticmethod
+    def report_figures(ds):
+        from matplotlib.figure import Figure
+
+        var = [v for v in ds.data_vars if ds[v].dims == ("increment", "point")][0]
+        fig = Figure(figsize=(5.6, 4.0), layout="constrained")
+        ax = fig.add_subplot()
+        for j, name in enumerate(ds["point"].values):
+            ax.plot(ds[var].values[:, j], ds["load"].values, "o-", ms=3, label=f"{name}")
+            if "reference_curve" in ds:
+                ax.plot(ds["reference_curve"].values[j],
+                        ds["reference_level"].values * float(ds["load"].values[-1]
+                                                             / ds["load_factor"].values[-1]),
+                        "ks", mfc="none", ms=5, label=f"{name} published" if j == 0 else None)
+        ax.set_xlabel(f"{var} (length)")
+        ax.set_ylabel("load")
+        ax.legend(fontsize=8)
+        return [("Load–deflection curves" + (f" (max rel. error vs published "
+                                              f"{float(ds['max_relative_error']):.2%})"
+                                              if "max_relative_error" in ds else ""), fig)]

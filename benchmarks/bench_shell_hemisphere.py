@@ -4,8 +4,8 @@ Issue target: about 10 000 DOF in under 60 s on this machine, with the time spli
 and ghosts, partition, charts, quadrature, assembly, loads, supports, solve). The full
 closed hemisphere (R = 10, h = 0.04, E = 6.825e7, ν = 0.3; thesis L1343) carries F = 2
 outward at (±10, 0, 0) and inward at (0, ±10, 0); rigid motions are removed by holding the
-pole (3 components) and u_z at (10, 0, 0) and (0, 10, 0) and u_y at (10, 0, 0), which take
-no reaction under this self-equilibrated load.
+pole's displacement and normal (by symmetry u = 0 relative to it and δn = 0 there) and u_y at
+(10, 0, 0) (zero by symmetry), so the supports take no reaction.
 
 It then solves the same constrained system with the alternative solver (CG with an
 incomplete-LU preconditioner) and compares time and answer with the default sparse direct
@@ -36,9 +36,8 @@ def settings() -> ShellSettings:
 
     return ShellSettings(
         young_modulus=6.825e7, poisson_ratio=0.3, thickness=0.04,
-        supports=[Support(kind="fixed", components=[0, 1, 2], where=at("z > 9.9999", False)),
-                  Support(kind="fixed", components=[1, 2], where=at("x > 9.9999")),
-                  Support(kind="fixed", components=[2], where=at("y > 9.9999"))],
+        supports=[Support(kind="clamped", where=at("z > 9.9999", False)),
+                  Support(kind="fixed", components=[1], where=at("x > 9.9999"))],
         loads=[Load(kind="point", at=[10, 0, 0], force=[2, 0, 0]),
                Load(kind="point", at=[-10, 0, 0], force=[-2, 0, 0]),
                Load(kind="point", at=[0, 10, 0], force=[0, -2, 0]),

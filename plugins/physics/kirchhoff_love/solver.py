@@ -58,7 +58,7 @@ def factorize(A: csr_matrix, method: str = "direct"):
     M = LinearOperator(A.shape, ilu.solve)
 
     def solve(b):
-        x, info = cg(A, b, M=M, rtol=1e-12, maxiter=5000)
+        x, info = cg(A, b, M=M, rtol=1e-12, maxiter=2000)
         if info != 0:
             raise InputError(f"CG with incomplete LU did not converge ({info} iterations); "
                              "use physics.solver=direct.")

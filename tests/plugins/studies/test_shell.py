@@ -1,5 +1,4 @@
 """The shell study end to end from the command line, and its convergence post-processing."""
-from pathlib import Path
 
 import numpy as np
 import pytest

@@ -30,7 +30,8 @@ class ShellPathSettings(ShellStudySettings):
     max_load_factor: float = 1.0
     max_newton: int = 15
     newton_tol: float = 1e-8
-    full_load: float = 1.0              # the applied force at load factor 1 (for ``load``)
+    full_load: float = 1.0              # force at load factor 1 (0: displacement control,
+    #                                     ``load`` is then the reaction of the last support)
     monitor_points: List[float] = field(default_factory=list)       # x, y, z per point
     monitor_directions: List[float] = field(default_factory=list)   # unit vector per point
     monitor_names: List[str] = field(default_factory=list)
@@ -149,10 +150,15 @@ class ShellNonlinearStudy:
             mon = np.abs(mon)
         lam = np.array([r.load_factor for r in records])
         one = {"units": "1"}
+        load, load_name = lam * self.full_load, "applied force λ·full_load"
+        reactions = [r.reactions for r in records if r.reactions is not None]
+        if self.full_load == 0.0 and len(reactions) == len(records) and records:
+            # displacement control: the load is the reaction of the imposed displacement
+            load = np.array([np.linalg.norm(r[-1]) for r in reactions])
+            load_name = "reaction force of the last support (imposed displacement)"
         data = {
             "load_factor": (("increment",), lam, {**one, "long_name": "load factor λ"}),
-            "load": (("increment",), lam * self.full_load, {
-                "long_name": "applied force λ·full_load", "units": "force"}),
+            "load": (("increment",), load, {"long_name": load_name, "units": "force"}),
             self.monitor_variable: (("increment", "point"), mon, {
                 "long_name": "displacement at the monitored point along its direction"
                              + (" (magnitude)" if self.monitor_magnitude else ""),
@@ -165,6 +171,10 @@ class ShellNonlinearStudy:
                 "long_name": "wall time of the increment", "units": "s"}),
             "dof": ((), model.dof, {**one, "long_name": "degrees of freedom"}),
         }
+        if reactions and len(reactions) == len(records):
+            data["reaction"] = (("increment", "support", "dim"), np.stack(reactions), {
+                "long_name": "resultant force each support exerts on the shell",
+                "units": "force"})
         for part in ("membrane", "bending", "total"):
             data[f"energy_{part}"] = (("increment",), [r.energy.get(part, np.nan)
                                                        for r in records],
@@ -172,7 +182,11 @@ class ShellNonlinearStudy:
         ds = xr.Dataset(data, coords={
             "increment": ("increment", np.arange(len(records)), {**one,
                                                                  "long_name": "increment"}),
-            "point": ("point", names, {**one, "long_name": "monitored point"})})
+            "point": ("point", names, {**one, "long_name": "monitored point"}),
+            "dim": ("dim", ["x", "y", "z"], {**one, "long_name": "Cartesian component"})})
+        if "reaction" in ds:
+            ds = ds.assign_coords(support=("support", np.arange(ds.sizes["support"]), {
+                **one, "long_name": "index into physics.supports"}))
         if self.reference_load_factors and len(records):
             ref = np.asarray(self.reference_values, float).reshape(len(names), -1)
             lf = np.asarray(self.reference_load_factors, float)

@@ -2,9 +2,12 @@
 
 Thesis §4.4 / Paper 2 §4–5 and App. E.2: the total potential Π(U) = W(U) − λ FᵀU of the
 geometrically exact Kirchhoff–Love energy W (St. Venant–Kirchhoff, :mod:`.nonlinear`) is
-minimised at each load factor λ subject to the supports C U = g. Each Newton step solves
+minimised at each load factor λ subject to the supports C U = λ g: loads and imposed
+displacements are both scaled by λ, so a path with F = 0 and an imposed displacement is
+under displacement control (the reaction of that support is then the load). Each Newton
+step solves
 
-    min ½ ΔUᵀ K_T ΔU + Rᵀ ΔU   subject to   C ΔU = g − C U,    R = f_int(U) − λF + Cᵀμ,
+    min ½ ΔUᵀ K_T ΔU + Rᵀ ΔU   subject to   C ΔU = λg − C U,    R = f_int(U) − λF + Cᵀμ,
 
 by the augmented Lagrangian of :mod:`.solver` (its multiplier increment updates μ). A step
 that does not converge in ``max_newton`` iterations (or produces NaN) is cut in half and
@@ -23,6 +26,16 @@ import numpy as np
 from pointatlas.errors import PointatlasError
 
 
+def support_reactions(C, mu: np.ndarray, row_support: np.ndarray) -> np.ndarray:
+    """Resultant force (n_supports, 3) each support exerts on the shell, −Σ rows Cᵀμ."""
+    n = int(row_support.max()) + 1 if row_support.size else 0
+    out = np.zeros((n, 3))
+    for k in range(n):
+        rows = row_support == k
+        out[k] = -(C[rows].T @ mu[rows]).reshape(-1, 3).sum(axis=0)
+    return out
+
+
 class PathFollowingError(PointatlasError):
     """The load path could not be followed further (the converged increments are kept)."""
 
@@ -39,6 +52,7 @@ class Increment:
     negative_pivots: int
     stable: bool
     seconds: float
+    reactions: Optional[np.ndarray] = None   # (n_supports, 3) resultant reaction forces
 
 
 @dataclass
@@ -73,11 +87,11 @@ def follow_path(model, settings, path: PathSettings, F: np.ndarray, constraints,
         t0 = time.perf_counter()
         U_try, mu_try = U.copy(), mu.copy()
         residuals, ok, negative = [], False, -1
-        scale = max(np.linalg.norm(target * Fv), 1e-300)
+        scale = max(float(np.linalg.norm(target * Fv)), 1e-300)
         for it in range(1, path.max_newton + 1):
             R = internal_forces(q, mat, U_try).ravel() - target * Fv + C.T @ mu_try
             K = regularize_ghosts(tangent_stiffness(q, mat, U_try), model)
-            dU, dmu, info = solve_augmented(K, -R, C, g - C @ U_try, settings.penalty,
+            dU, dmu, info = solve_augmented(K, -R, C, target * g - C @ U_try, settings.penalty,
                                             settings.constraint_tol, method=settings.solver)
             if not np.all(np.isfinite(dU)):
                 break
@@ -86,7 +100,8 @@ def follow_path(model, settings, path: PathSettings, F: np.ndarray, constraints,
             negative = info.negative_pivots
             R = internal_forces(q, mat, U_try).ravel() - target * Fv + C.T @ mu_try
             # the residual that matters is the one along admissible motions: project out Cᵀμ
-            res = float(np.linalg.norm(R)) / scale
+            # scale: the applied load, or the reactions under displacement control (F = 0)
+            res = float(np.linalg.norm(R)) / max(scale, float(np.linalg.norm(C.T @ mu_try)))
             residuals.append(res)
             if log is not None:
                 log.info("  λ = %.5g  Newton %d: |R|/|λF| = %.3e  |ΔU| = %.3e", target, it, res,
@@ -111,7 +126,8 @@ def follow_path(model, settings, path: PathSettings, F: np.ndarray, constraints,
         U, mu, lam_load = U_try, mu_try, target
         e = energy(q, mat, U)
         inc = Increment(lam_load, U.reshape(-1, 3).copy(), it, residuals, e, negative,
-                        negative == 0, time.perf_counter() - t0)
+                        negative == 0, time.perf_counter() - t0,
+                        support_reactions(C, mu, constraints.row_support))
         done.append(inc)
         if on_increment is not None:
             on_increment(inc)

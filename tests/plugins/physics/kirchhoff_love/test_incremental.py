@@ -39,3 +39,26 @@ def test_unconvergeable_path_stops_with_the_remedies(plate):
         follow_path(m, s, PathSettings(n_increments=1, max_newton=1, min_step=0.3), F, cons,
                     on_increment=kept.append)
     assert all(np.isfinite(k.U).all() for k in kept)
+
+
+def test_displacement_control_reaction_equals_the_force(plate):
+    """Imposing the centre deflection of a force-controlled run gives back that force as the
+    reaction of the imposed-displacement support (small load: linear regime)."""
+    from dataclasses import replace
+
+    from pointatlas_physics.kirchhoff_love.selector_spec import Selector
+    from pointatlas_physics.kirchhoff_love.settings import Support
+
+    m, s, F, cons = plate
+    forced = follow_path(m, s, PathSettings(n_increments=1), 1e-3 * F, cons)
+    m.nodal_displacement = forced[-1].U
+    w = displacement_at(m, [0, 0, 0])[0][2]
+    centre = Support(kind="displacement", components=[2], value=[0.0, 0.0, float(w)],
+                     where=Selector(box=[-0.01, -0.01, -1, 0.01, 0.01, 1], on_boundary=False))
+    s2 = replace(s, supports=[*s.supports, centre], loads=[])
+    cons2 = assemble_supports(m, s2)
+    path = follow_path(m, s2, PathSettings(n_increments=2), 0.0 * F, cons2)
+    assert [round(i.load_factor, 12) for i in path] == [0.5, 1.0]
+    # the centre support pushes with the force the load applied: −(−50 × 1e-3) along z
+    assert path[-1].reactions[-1][2] == pytest.approx(1e-3 * F.sum(axis=0)[2], rel=2e-3)
+    assert path[0].reactions[-1][2] == pytest.approx(0.5 * path[-1].reactions[-1][2], rel=1e-3)

@@ -15,6 +15,7 @@ from scipy.spatial import cKDTree
 
 from pointatlas.basis import BasisFunctions
 from pointatlas.errors import ConfigError, InputError
+from pointatlas.stores_config import stores_config
 
 from . import lme_kernels as K
 from .support import SupportGrid, locality, nodal_spacing, support_radius
@@ -31,6 +32,7 @@ from .validation import (
 )
 
 
+@stores_config
 class LocalMaxEnt:
     """Local max-ent basis functions on scattered nodes in any dimension d.
 
@@ -71,15 +73,6 @@ class LocalMaxEnt:
         "outside": "'error' or 'flag'",
     }
 
-    def __init__(self, *, gamma: float = 0.8, tol: float = 1e-10,
-                 n_spacing_neighbors: Optional[int] = None, newton_tol: float = 1e-12,
-                 max_iter: int = 100, outside: str = "error"):
-        self.gamma = gamma
-        self.tol = tol
-        self.n_spacing_neighbors = n_spacing_neighbors
-        self.newton_tol = newton_tol
-        self.max_iter = max_iter
-        self.outside = outside
 
     def _check_config(self):
         name = "LocalMaxEnt"

@@ -21,6 +21,7 @@ from scipy.spatial import cKDTree
 
 from pointatlas.basis import BasisFunctions
 from pointatlas.errors import InputError
+from pointatlas.stores_config import stores_config
 
 from .support import SupportGrid, locality, nodal_spacing, scan, support_radius
 from .validation import (
@@ -99,6 +100,7 @@ def shepard_kernel(points, visit, cell, starts, entries, entry_x, entry_r2, beta
                     hess[lo + q, a, b] = values[lo + q] * s
 
 
+@stores_config
 class Shepard:
     """Gaussian Shepard partition of unity on scattered nodes (markers) in any dimension.
 
@@ -126,12 +128,6 @@ class Shepard:
         "outside": "'error' or 'flag'",
     }
 
-    def __init__(self, *, gamma: float = 4.0, tol: float = 1e-6,
-                 n_spacing_neighbors: Optional[int] = None, outside: str = "error"):
-        self.gamma = gamma
-        self.tol = tol
-        self.n_spacing_neighbors = n_spacing_neighbors
-        self.outside = outside
 
     def _check_config(self):
         check_positive("gamma", self.gamma, plugin="Shepard")

@@ -31,6 +31,12 @@ class AtlasSettings:
     #                                       of the triangles, with no folds
     max_refinement_depth: int = 6
 
+    @classmethod
+    def of(cls, obj) -> "AtlasSettings":
+        """The atlas settings held as attributes of ``obj`` (a study whose Config extends or
+        equals this class)."""
+        return cls(**{k: getattr(obj, k) for k in cls.__dataclass_fields__})
+
     def check(self) -> None:
         for name in ("gamma_lme", "tol_lme", "gamma_pu", "tol_pu", "chart_margin",
                      "max_stress", "max_distortion"):

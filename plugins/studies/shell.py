@@ -42,7 +42,7 @@ class ShellStudy:
         "point vs published values, deformed shape (.vtp).")
 
     def atlas_settings(self) -> AtlasSettings:
-        return AtlasSettings(**{k: getattr(self, k) for k in AtlasSettings.__dataclass_fields__})
+        return AtlasSettings.of(self)
 
     def run(self, ctx):
         from pointatlas.errors import ConfigError

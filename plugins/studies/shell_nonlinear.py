@@ -55,7 +55,7 @@ class ShellNonlinearStudy:
     def atlas_settings(self):
         from pointatlas_atlas.settings import AtlasSettings
 
-        return AtlasSettings(**{k: getattr(self, k) for k in AtlasSettings.__dataclass_fields__})
+        return AtlasSettings.of(self)
 
     def _monitors(self):
         from pointatlas.errors import ConfigError
@@ -92,16 +92,18 @@ class ShellNonlinearStudy:
             cons = assemble_supports(model, s)
         start = self._resume(model) if self.resume_from else None
         records = [] if start is None else [start]
+        probe = monitor_operator(model, P, E)   # projections once, not per increment
+        values = [probe(r.U) for r in records]
         path = PathSettings(self.n_increments, self.max_load_factor, self.max_newton,
                             self.newton_tol)
 
         def keep(inc):
             records.append(inc)
+            values.append(probe(inc.U))
             ctx.log.info("increment %d: λ = %.5g, %d Newton iterations, %s; %s", len(records),
                          inc.load_factor, inc.iterations, "stable" if inc.stable else "UNSTABLE",
-                         ", ".join(f"{n} = {v:.5g}" for n, v in
-                                   zip(names, self._monitor_values(model, P, E, inc.U))))
-            self._write(ctx.run_dir / "increments.nc", model, records, P, E, names)
+                         ", ".join(f"{n} = {v:.5g}" for n, v in zip(names, values[-1])))
+            self._write(ctx.run_dir / "increments.nc", model, records, values, names)
 
         from pointatlas_physics.kirchhoff_love.incremental import PathFollowingError
 
@@ -112,7 +114,7 @@ class ShellNonlinearStudy:
             except PathFollowingError as exc:
                 stopped = str(exc)
                 ctx.log.error("%s", exc)
-        ds = self._dataset(model, records, P, E, names)
+        ds = self._dataset(model, records, values, names)
         ds.attrs["stopped"] = stopped or "completed the load path"
         return ds
 
@@ -131,21 +133,10 @@ class ShellNonlinearStudy:
                              f"{model.nodes.shape[0]}: resume with the same source and settings.")
         return Increment(lam, U, 0, [], {}, -1, True, 0.0)
 
-    @staticmethod
-    def _monitor_values(model, P, E, U):
-        from pointatlas_physics.kirchhoff_love.analysis import displacement_at
-
-        saved = model.nodal_displacement
-        model.nodal_displacement = U
-        vals = np.array([float(displacement_at(model, p)[0] @ e) for p, e in zip(P, E)])
-        model.nodal_displacement = saved
-        return vals
-
-    def _dataset(self, model, records, P, E, names):
+    def _dataset(self, model, records, values, names):
         import xarray as xr
 
-        mon = np.array([self._monitor_values(model, P, E, r.U) for r in records]).reshape(
-            len(records), len(names))
+        mon = np.asarray(values, dtype=float).reshape(len(records), len(names))
         if self.monitor_magnitude:
             mon = np.abs(mon)
         lam = np.array([r.load_factor for r in records])
@@ -204,9 +195,9 @@ class ShellNonlinearStudy:
                                                       "largest relative error over the table"})
         return ds
 
-    def _write(self, path: Path, model, records, P, E, names):
+    def _write(self, path: Path, model, records, values, names):
         """increments.nc with all converged increments (temporary file, then rename)."""
-        ds = self._dataset(model, records, P, E, names)
+        ds = self._dataset(model, records, values, names)
         ds["nodal_displacement"] = (("increment", "node", "dim"),
                                     np.stack([r.U for r in records]),
                                     {"long_name": "nodal displacements U (ghosts included)",
@@ -235,3 +226,14 @@ class ShellNonlinearStudy:
         return [("Load–deflection curves" + (f" (max rel. error vs published "
                                               f"{float(ds['max_relative_error']):.2%})"
                                               if "max_relative_error" in ds else ""), fig)]
+
+
+def monitor_operator(model, P: np.ndarray, E: np.ndarray):
+    """U -> (u(p_i)·e_i)_i at the surface points nearest to P: the closest-point projections
+    and the basis there are computed once (Paper 2 App. A), then each call is one product."""
+    from pointatlas_atlas.evaluation import basis_at
+    from pointatlas_atlas.projection import closest_point
+
+    proj = closest_point(model.atlas, np.asarray(P, dtype=np.float64).reshape(-1, 3))
+    B = basis_at(model.atlas, proj.chart, proj.xi, order=0).to_csr(model.nodes.shape[0])
+    return lambda U: np.einsum("ij,ij->i", B @ np.asarray(U).reshape(-1, 3), E)

@@ -7,10 +7,12 @@ per patch, glue with the coarse Shepard partition of unity ψ_κ and integrate
 """
 from __future__ import annotations
 
-from typing import ClassVar, Optional
+from typing import ClassVar
 
 import numpy as np
 from pointatlas_atlas.settings import AtlasSettings
+
+from pointatlas.stores_config import stores_config
 
 #: exact-reference key -> (metric name, long name)
 QUANTITIES = {
@@ -20,6 +22,7 @@ QUANTITIES = {
 }
 
 
+@stores_config
 class SurfaceGeometry:
     """Build the atlas of the source's points; integrate area, H² and K; compare with exact."""
 
@@ -40,27 +43,9 @@ class SurfaceGeometry:
         "max_stress": "float > 0", "max_distortion": "float > 1",
     }
 
-    def __init__(self, *, n_patches: Optional[int] = None, markers_per_patch: int = 150,
-                 gamma_lme: float = 0.8, tol_lme: float = 1e-10, gamma_pu: float = 4.0,
-                 tol_pu: float = 1e-6, quadrature_order: int = 6, least_squares_fit: bool = True,
-                 chart_margin: float = 3.0, graph_neighbors: int = 10, max_stress: float = 0.02,
-                 max_distortion: float = 2.5, max_refinement_depth: int = 6):
-        self.n_patches = n_patches
-        self.markers_per_patch = markers_per_patch
-        self.gamma_lme = gamma_lme
-        self.tol_lme = tol_lme
-        self.gamma_pu = gamma_pu
-        self.tol_pu = tol_pu
-        self.quadrature_order = quadrature_order
-        self.least_squares_fit = least_squares_fit
-        self.chart_margin = chart_margin
-        self.graph_neighbors = graph_neighbors
-        self.max_stress = max_stress
-        self.max_distortion = max_distortion
-        self.max_refinement_depth = max_refinement_depth
 
     def settings(self):
-        return AtlasSettings(**{k: getattr(self, k) for k in self.Config.__dataclass_fields__})
+        return AtlasSettings.of(self)
 
     def build_atlas(self, ctx, cloud):
         from pointatlas_atlas.atlas import Atlas

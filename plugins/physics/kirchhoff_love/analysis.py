@@ -166,7 +166,7 @@ def assemble_loads(model: ShellModel, settings, log=None) -> np.ndarray:
             F += surface_load(model.quadrature, F.shape[0], ld.force, ld.pressure, normals)
         else:
             F += line_load(model.atlas, model.points, model.boundary, model.curves,
-                           ld.where, ld.force)
+                           ld.where, ld.force, model.spacing)
     return F
 
 

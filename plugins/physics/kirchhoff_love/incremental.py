@@ -88,8 +88,8 @@ def follow_path(model, settings, path: PathSettings, F: np.ndarray, constraints,
         U_try, mu_try = U.copy(), mu.copy()
         residuals, ok, negative = [], False, -1
         scale = max(float(np.linalg.norm(target * Fv)), 1e-300)
+        R = internal_forces(q, mat, U_try).ravel() - target * Fv + C.T @ mu_try
         for it in range(1, path.max_newton + 1):
-            R = internal_forces(q, mat, U_try).ravel() - target * Fv + C.T @ mu_try
             K = regularize_ghosts(tangent_stiffness(q, mat, U_try), model)
             dU, dmu, info = solve_augmented(K, -R, C, target * g - C @ U_try, settings.penalty,
                                             settings.constraint_tol, method=settings.solver)
@@ -98,9 +98,9 @@ def follow_path(model, settings, path: PathSettings, F: np.ndarray, constraints,
             U_try += dU
             mu_try += dmu
             negative = info.negative_pivots
-            R = internal_forces(q, mat, U_try).ravel() - target * Fv + C.T @ mu_try
-            # the residual that matters is the one along admissible motions: project out Cᵀμ
+            # the residual after the step (also the right-hand side of the next step); its
             # scale: the applied load, or the reactions under displacement control (F = 0)
+            R = internal_forces(q, mat, U_try).ravel() - target * Fv + C.T @ mu_try
             res = float(np.linalg.norm(R)) / max(scale, float(np.linalg.norm(C.T @ mu_try)))
             residuals.append(res)
             if log is not None:

@@ -53,8 +53,9 @@ def surface_load(quadrature, n_nodes: int, force=None, pressure=None, normals=No
     return F
 
 
-def line_load(atlas, points, boundary, curves, where, force):
-    """Nodal forces of a force per unit length on the boundary points ``where`` selects."""
+def line_load(atlas, points, boundary, curves, where, force, spacing: float):
+    """Nodal forces of a force per unit length on the boundary points ``where`` selects
+    (``spacing``: median point spacing; longer steps along a curve are not segments)."""
     from pointatlas_atlas.evaluation import basis_at_nodes
 
     nodes = select(where, points, boundary, curves)
@@ -62,7 +63,7 @@ def line_load(atlas, points, boundary, curves, where, force):
 
     picked = np.zeros(points.shape[0], bool)
     picked[nodes] = True
-    seg = curve_segments(points, curves, 2.0 * _spacing(points))
+    seg = curve_segments(points, curves, 2.0 * spacing)
     seg = seg[picked[seg[:, 0]] & picked[seg[:, 1]]]
     ell = np.linalg.norm(points[seg[:, 0]] - points[seg[:, 1]], axis=1)
     length = 0.5 * (np.bincount(seg[:, 0], ell, points.shape[0])
@@ -80,8 +81,3 @@ def line_load(atlas, points, boundary, curves, where, force):
         F[:, j] = np.bincount(basis.indices, weights=w * t[j], minlength=F.shape[0])
     return F
 
-
-def _spacing(points: np.ndarray) -> float:
-    from scipy.spatial import cKDTree
-
-    return float(np.median(cKDTree(points).query(points, k=2)[0][:, 1]))

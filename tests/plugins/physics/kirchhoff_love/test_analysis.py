@@ -99,7 +99,8 @@ def test_line_and_pressure_loads_total_their_resultants(solved):
 
     model, _ = solved
     edge = Selector(plane=[1, 0, 0, 5.0])
-    f = line_load(model.atlas, model.points, model.boundary, model.curves, edge, [0, 0, -3.0])
+    f = line_load(model.atlas, model.points, model.boundary, model.curves, edge, [0, 0, -3.0],
+                  model.spacing)
     assert f.sum(axis=0) == pytest.approx([0, 0, -3.0 * 5.0], rel=1e-8)  # 3 per length × 5
     n = _quadrature_normals(model.quadrature, model.nodes)
     f = surface_load(model.quadrature, model.nodes.shape[0], pressure=2.0, normals=n)

@@ -1,8 +1,16 @@
 """Geometrically nonlinear shell analysis along a load path (thesis §4.4, Paper 2 §4–5).
 
 The ``kirchhoff_love`` plugin builds the atlas, loads and supports; this study follows the
-load path under force control (:mod:`pointatlas_physics.kirchhoff_love.incremental`) and
-records, along a dim ``increment``: ``load_factor``, ``load`` (= load_factor × ``full_load``),
+load path (:mod:`pointatlas_physics.kirchhoff_love.incremental`) under ``control``:
+
+- ``force``: the loads grow with λ (uniform steps, cut on failure);
+- ``displacement``: the ``displacement`` supports' imposed values grow with λ, there are no
+  loads, and ``load`` is the reaction of those supports along their imposed direction;
+- ``arc_length``: Crisfield's arc length (:mod:`pointatlas_physics.kirchhoff_love.arc_length`)
+  on loads and imposed displacements together, through limit points and snap-backs;
+
+and records, along a dim ``increment``: ``load_factor``, ``load`` (= load_factor × ``full_load``
+under loads),
 the monitored displacements (``monitor_variable`` with dims (increment, point), point named
 by ``monitor_names``), the energy split, Newton iterations and the displacement field. After
 every converged increment ``increments.nc`` in the run directory is rewritten (atomically), so
@@ -30,8 +38,12 @@ class ShellPathSettings(ShellStudySettings):
     max_load_factor: float = 1.0
     max_newton: int = 15
     newton_tol: float = 1e-8
-    full_load: float = 1.0              # force at load factor 1 (0: displacement control,
-    #                                     ``load`` is then the reaction of the last support)
+    full_load: float = 1.0              # force at load factor 1 (reported as ``load``)
+    control: str = "force"              # force | displacement | arc_length
+    lbfgs_iterations: int = 0           # L-BFGS iterations before Newton in each increment
+    lbfgs_tol: float = 1.0e-2           # ... until |∇Π| ≤ lbfgs_tol·|load|
+    line_search: bool = False           # Armijo backtracking in Newton (see incremental)
+    max_increments: int = 400           # arc length: increments before giving up
     monitor_points: List[float] = field(default_factory=list)       # x, y, z per point
     monitor_directions: List[float] = field(default_factory=list)   # unit vector per point
     monitor_names: List[str] = field(default_factory=list)
@@ -49,8 +61,9 @@ class ShellNonlinearStudy:
 
     Config = ShellPathSettings
     description: ClassVar[str] = (
-        "Geometrically nonlinear Kirchhoff–Love shell along a load path (force control, "
-        "Newton, step cutting, stability by pivot signs); load–deflection curves.")
+        "Geometrically nonlinear Kirchhoff–Love shell along a load path (force, displacement "
+        "or arc-length control; L-BFGS + Newton with line search; step cutting; stability by "
+        "pivot signs); load–deflection curves.")
 
     def atlas_settings(self):
         from pointatlas_atlas.settings import AtlasSettings
@@ -93,13 +106,24 @@ class ShellNonlinearStudy:
         start = self._resume(model) if self.resume_from else None
         records = [] if start is None else [start]
         probe = monitor_operator(model, P, E)   # projections once, not per increment
+        fields = point_fields(model)             # u and energy density at the sampled points
         values = [probe(r.U) for r in records]
+        self._fields = [fields(r.U) for r in records]
+        self._points = model.points
+        F = self._control_loads(F, s)
         path = PathSettings(self.n_increments, self.max_load_factor, self.max_newton,
-                            self.newton_tol)
+                            self.newton_tol, control="arc_length" if self.control ==
+                            "arc_length" else "load", lbfgs_iterations=self.lbfgs_iterations,
+                            lbfgs_tol=self.lbfgs_tol, line_search=self.line_search,
+                            max_increments=self.max_increments)
+        self._imposed = [(k, np.asarray(sup.value, float)) for k, sup in enumerate(s.supports)
+                         if sup.kind == "displacement"]
+        self._has_loads = bool(np.any(F))
 
         def keep(inc):
             records.append(inc)
             values.append(probe(inc.U))
+            self._fields.append(fields(inc.U))
             ctx.log.info("increment %d: λ = %.5g, %d Newton iterations, %s; %s", len(records),
                          inc.load_factor, inc.iterations, "stable" if inc.stable else "UNSTABLE",
                          ", ".join(f"{n} = {v:.5g}" for n, v in zip(names, values[-1])))
@@ -117,6 +141,40 @@ class ShellNonlinearStudy:
         ds = self._dataset(model, records, values, names)
         ds.attrs["stopped"] = stopped or "completed the load path"
         return ds
+
+    def _control_loads(self, F, s):
+        """The load vector the control uses; checks that the control has something to do."""
+        from pointatlas.errors import ConfigError
+
+        controls = ("force", "displacement", "arc_length")
+        if self.control not in controls:
+            raise ConfigError(f"study.control = {self.control!r} is unknown; use one of "
+                              f"{controls}.")
+        imposed = any(sup.kind == "displacement" for sup in s.supports)
+        if self.control == "displacement":
+            if not imposed:
+                raise ConfigError("study.control=displacement needs a support of kind "
+                                  "'displacement' (its value grows with the load factor).")
+            if np.any(F):
+                raise ConfigError("study.control=displacement applies no loads, but "
+                                  "physics.loads is not empty: remove the loads, or use "
+                                  "study.control=force or arc_length to scale both.")
+        elif not np.any(F) and not imposed:
+            raise ConfigError(f"study.control={self.control} but there is nothing to apply: "
+                              "give physics.loads or a 'displacement' support.")
+        return F
+
+    def _load(self, lam, reactions):
+        """(load, long_name): λ·full_load under loads; otherwise the reaction of the
+        'displacement' supports along their imposed direction (force)."""
+        if self._has_loads or not self._imposed or reactions is None:
+            return lam * self.full_load, "applied force λ·full_load"
+        total = 0.0
+        for k, value in self._imposed:
+            e = value / max(np.linalg.norm(value), 1e-300)
+            total += float(reactions[k] @ e)
+        return total, ("reaction force of the imposed-displacement supports along their "
+                       "imposed direction")
 
     def _resume(self, model):
         import xarray as xr
@@ -141,12 +199,10 @@ class ShellNonlinearStudy:
             mon = np.abs(mon)
         lam = np.array([r.load_factor for r in records])
         one = {"units": "1"}
-        load, load_name = lam * self.full_load, "applied force λ·full_load"
         reactions = [r.reactions for r in records if r.reactions is not None]
-        if self.full_load == 0.0 and len(reactions) == len(records) and records:
-            # displacement control: the load is the reaction of the imposed displacement
-            load = np.array([np.linalg.norm(r[-1]) for r in reactions])
-            load_name = "reaction force of the last support (imposed displacement)"
+        pairs = [self._load(r.load_factor, r.reactions) for r in records]
+        load = np.array([p[0] for p in pairs], dtype=float)
+        load_name = pairs[-1][1] if pairs else "load"
         data = {
             "load_factor": (("increment",), lam, {**one, "long_name": "load factor λ"}),
             "load": (("increment",), load, {"long_name": load_name, "units": "force"}),
@@ -166,6 +222,19 @@ class ShellNonlinearStudy:
             data["reaction"] = (("increment", "support", "dim"), np.stack(reactions), {
                 "long_name": "resultant force each support exerts on the shell",
                 "units": "force"})
+        if len(self._fields) == len(records) and records:
+            u = np.stack([f[0] for f in self._fields])
+            w = np.stack([f[1] for f in self._fields])
+            data["position"] = (("sample", "dim"), self._points, {
+                "long_name": "sampled point x_a (reference configuration)", "units": "length"})
+            data["displacement_field"] = (("increment", "sample", "dim"), u, {
+                "long_name": "displacement u(x_a) at the sampled points", "units": "length"})
+            data["energy_density"] = (("increment", "sample"), w[:, :, 2], {
+                "long_name": "strain energy per unit reference area (membrane + bending)",
+                "units": "energy/length²"})
+            data["bending_fraction"] = (("increment", "sample"), w[:, :, 1] / np.where(
+                w[:, :, 2] > 0, w[:, :, 2], 1.0), {
+                "units": "1", "long_name": "bending share of the energy density"})
         for part in ("membrane", "bending", "total"):
             data[f"energy_{part}"] = (("increment",), [r.energy.get(part, np.nan)
                                                        for r in records],
@@ -174,15 +243,16 @@ class ShellNonlinearStudy:
             "increment": ("increment", np.arange(len(records)), {**one,
                                                                  "long_name": "increment"}),
             "point": ("point", names, {**one, "long_name": "monitored point"}),
-            "dim": ("dim", ["x", "y", "z"], {**one, "long_name": "Cartesian component"})})
+            "dim": ("dim", ["x", "y", "z"], {**one, "long_name": "Cartesian component"}),
+            "sample": ("sample", np.arange(len(self._points)), {
+                **one, "long_name": "sampled point index"})})
         if "reaction" in ds:
             ds = ds.assign_coords(support=("support", np.arange(ds.sizes["support"]), {
                 **one, "long_name": "index into physics.supports"}))
         if self.reference_load_factors and len(records):
             ref = np.asarray(self.reference_values, float).reshape(len(names), -1)
             lf = np.asarray(self.reference_load_factors, float)
-            ours = np.array([np.interp(lf, lam, mon[:, j], left=np.nan, right=np.nan)
-                             for j in range(len(names))])
+            ours = np.array([first_crossing(lf, lam, mon[:, j]) for j in range(len(names))])
             err = np.abs(ours - ref) / np.abs(ref)
             ds = ds.assign_coords(reference_level=("reference_level", lf, {
                 **one, "long_name": "tabulated load factor"}))
@@ -223,9 +293,53 @@ class ShellNonlinearStudy:
         ax.set_xlabel(f"{var} (length)")
         ax.set_ylabel("load")
         ax.legend(fontsize=8)
-        return [("Load–deflection curves" + (f" (max rel. error vs published "
-                                              f"{float(ds['max_relative_error']):.2%})"
-                                              if "max_relative_error" in ds else ""), fig)]
+        figures = [("Load–deflection curves" + (f" (max rel. error vs published "
+                                                 f"{float(ds['max_relative_error']):.2%})"
+                                                 if "max_relative_error" in ds else ""), fig)]
+        if "energy_density" in ds and ds.sizes["increment"]:
+            from pointatlas_physics.kirchhoff_love.snapshots import (pick_snapshots,
+                                                                     snapshot_figure)
+
+            picks = pick_snapshots(ds.sizes["increment"], 4)
+            x = ds["position"].values
+            figures.append((
+                "Deformed configurations (not magnified) coloured by strain energy density",
+                snapshot_figure(
+                    x, [ds["displacement_field"].values[k] for k in picks],
+                    [ds["energy_density"].values[k] for k in picks],
+                    [f"increment {k + 1}: load {float(ds['load'].values[k]):.4g}"
+                     for k in picks])))
+        return figures
+
+
+def point_fields(model):
+    """U -> (u(x_a) (n, 3), energy density (n, 3): membrane, bending, total) at the sampled
+    points; the bases are computed once."""
+    from pointatlas_atlas.evaluation import basis_at_nodes
+    from pointatlas_physics.kirchhoff_love.snapshots import point_energy_operator
+
+    basis, _, _ = basis_at_nodes(model.atlas, np.arange(model.points.shape[0]), order=0)
+    B = basis.to_csr(model.nodes.shape[0])
+    energy_at = point_energy_operator(model)
+    return lambda U: (B @ np.asarray(U).reshape(-1, 3), energy_at(U))
+
+
+def first_crossing(levels, lam, values) -> np.ndarray:
+    """values interpolated at each load level where the path λ(increment) first reaches it
+    (NaN if never): what force control would report, even when an arc-length path turns
+    back at a limit point (the later crossings of a level lie on the unstable branch and on
+    the branch the snap-through lands on; the table lists the first)."""
+    lam = np.concatenate([[0.0], np.asarray(lam, float)])
+    values = np.concatenate([[0.0], np.asarray(values, float)])
+    out = np.full(len(levels), np.nan)
+    for i, level in enumerate(levels):
+        for k in range(len(lam) - 1):
+            a, b = lam[k], lam[k + 1]
+            if b > a and a <= level <= b:
+                t = (level - a) / (b - a)
+                out[i] = (1 - t) * values[k] + t * values[k + 1]
+                break
+    return out
 
 
 def monitor_operator(model, P: np.ndarray, E: np.ndarray):

@@ -180,13 +180,11 @@ def assemble_supports(model: ShellModel, settings):
     return cons
 
 
-def regularize_ghosts(K, model: ShellModel, eps: float = 1e-10):
-    """K plus a weak spring ε·mean(diag K) on ghost DOFs, and a unit-scaled one on DOFs no
-    quadrature point sees. A ghost node far out carries basis functions that are ~0 on the
-    sampled surface (cut off by the LME tolerance), so its DOFs are (nearly) free: the
-    spring pins them at 0 without changing the displacement of the surface noticeably."""
-    from scipy.sparse import diags
-
+def ghost_springs(K, model: ShellModel, eps: float = 1e-10) -> np.ndarray:
+    """(3(N+G),) spring stiffness per DOF: ε·mean(diag K) on ghost DOFs and mean(diag K) on
+    DOFs no quadrature point sees. A ghost node far out carries basis functions that are ~0
+    on the sampled surface (cut off by the LME tolerance), so its DOFs are (nearly) free:
+    the spring pins them at 0 without changing the displacement of the surface noticeably."""
     n = model.nodes.shape[0]
     scale = float(K.diagonal().mean())
     node_w = np.zeros(n)
@@ -194,7 +192,14 @@ def regularize_ghosts(K, model: ShellModel, eps: float = 1e-10):
     seen = np.zeros(n, bool)
     seen[model.quadrature.indices] = True
     node_w[~seen] = 1.0
-    return (K + diags(np.repeat(node_w * scale, 3))).tocsr()
+    return np.repeat(node_w * scale, 3)
+
+
+def regularize_ghosts(K, model: ShellModel, eps: float = 1e-10):
+    """K plus the :func:`ghost_springs` on its diagonal."""
+    from scipy.sparse import diags
+
+    return (K + diags(ghost_springs(K, model, eps))).tocsr()
 
 
 def _quadrature_normals(q, nodes: np.ndarray) -> np.ndarray:

@@ -1,24 +1,36 @@
-"""Geometrically nonlinear shells under force control: load increments, Newton, step cutting.
+"""Geometrically nonlinear shells along a load path: increments, Newton, step cutting.
 
 Thesis §4.4 / Paper 2 §4–5 and App. E.2: the total potential Π(U) = W(U) − λ FᵀU of the
 geometrically exact Kirchhoff–Love energy W (St. Venant–Kirchhoff, :mod:`.nonlinear`) is
 minimised at each load factor λ subject to the supports C U = λ g: loads and imposed
 displacements are both scaled by λ, so a path with F = 0 and an imposed displacement is
-under displacement control (the reaction of that support is then the load). Each Newton
-step solves
+under displacement control (the reaction of that support is then the load). Under load
+(force or displacement) control each increment runs, for the target λ,
 
-    min ½ ΔUᵀ K_T ΔU + Rᵀ ΔU   subject to   C ΔU = λg − C U,    R = f_int(U) − λF + Cᵀμ,
+1. an optional coarse L-BFGS minimisation of the augmented Lagrangian Π_ρ
+   (:meth:`.equilibrium.Equilibrium.lbfgs`, ``lbfgs_iterations`` > 0), then
+2. Newton: min ½ ΔUᵀ K_T ΔU + Rᵀ ΔU subject to C ΔU = λg − C U,
+   R = f_int(U) − λF + Cᵀμ, by the augmented Lagrangian of :mod:`.solver` (its multiplier
+   increment updates μ), with a backtracking (Armijo) line search on Π_ρ while the residual
+   is large and the step is a descent direction.
 
-by the augmented Lagrangian of :mod:`.solver` (its multiplier increment updates μ). A step
-that does not converge in ``max_newton`` iterations (or produces NaN) is cut in half and
-retried from the last converged increment; below ``min_step`` the run stops cleanly with the
-converged increments kept and a message naming the remedies. The signs of the pivots of the
-factorised K_T + ρCᵀC flag unstable equilibria (negative pivots: not a minimum).
+Both safeguards are off by default: on the pinched open hemisphere (``shell_open_hemisphere``,
+200 points, first increment P = 20), full Newton steps converged in 8 iterations, while
+energy backtracking cut the first steps to α = 1/8 and the increment did not converge in 15;
+200 L-BFGS iterations left |∇Π_ρ| at ~1e5 × the load (the membrane/bending stiffness ratio
+(R/h)² defeats first-order methods without a preconditioner).
+
+``control='arc_length'`` follows the path by Crisfield's cylindrical arc length instead
+(:mod:`.arc_length`), passing limit points and snap-backs. A step that does not converge in
+``max_newton`` iterations (or produces NaN) is cut in half and retried from the last
+converged increment; below ``min_step`` the run stops cleanly with the converged increments
+kept and a message naming the remedies. The signs of the pivots of the factorised
+K_T + ρCᵀC flag unstable equilibria (negative pivots: not a minimum).
 """
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Callable, Optional
 
 import numpy as np
@@ -60,77 +72,128 @@ class PathSettings:
     n_increments: int = 20
     max_load_factor: float = 1.0
     max_newton: int = 12
-    tol: float = 1e-8             # Newton: |R| ≤ tol·|λF| and |ΔU| ≤ tol·|U|·1e2
-    min_step: float = 1e-4        # smallest load-factor increment before giving up
-    history: list = field(default_factory=list)
+    tol: float = 1e-8             # Newton: |R| ≤ tol·|λF| (or tol·|reactions|)
+    min_step: float = 1e-2        # smallest step (fraction of the nominal one) before giving up
+    control: str = "load"         # 'load' (force or displacement) or 'arc_length'
+    lbfgs_iterations: int = 0     # L-BFGS iterations before Newton (0: Newton only)
+    lbfgs_tol: float = 1e-2       # L-BFGS stops at |∇Π_ρ| ≤ lbfgs_tol·|load|
+    line_search: bool = False     # Armijo backtracking on Π_ρ while |R| > 1e-3·|load|
+    max_increments: int = 400     # arc length: give up after this many increments
+    desired_iterations: int = 5   # arc length: Newton iterations the step size aims at
 
 
 def follow_path(model, settings, path: PathSettings, F: np.ndarray, constraints,
                 on_increment: Optional[Callable[[Increment], None]] = None, log=None,
                 start: Optional[Increment] = None) -> list[Increment]:
-    """Increments from λ = 0 (or ``start``) to ``path.max_load_factor`` under force control."""
-    from .analysis import regularize_ghosts
-    from .nonlinear import energy, internal_forces, tangent_stiffness
-    from .solver import solve_augmented
+    """Increments from λ = 0 (or ``start``) to ``path.max_load_factor``: load control
+    (uniform steps, cut on failure) or arc length (``path.control``)."""
+    from .equilibrium import Equilibrium
 
-    q, mat = model.quadrature, model.material
-    C, g = constraints.matrix, constraints.rhs
-    Fv = F.ravel()
-    U = np.zeros(Fv.size) if start is None else start.U.ravel().copy()
+    eq = Equilibrium(model, settings, F, constraints)
+    if path.control == "arc_length":
+        from .arc_length import follow_arc_length
+
+        return follow_arc_length(eq, path, on_increment, log, start)
+    if path.control != "load":
+        raise ValueError(f"unknown control {path.control!r}: use 'load' or 'arc_length'")
+    U = np.zeros(eq.F.size) if start is None else start.U.ravel().copy()
     lam_load = 0.0 if start is None else start.load_factor
-    mu = np.zeros(C.shape[0])
-    step = path.max_load_factor / path.n_increments
+    mu = np.zeros(eq.C.shape[0])
+    nominal = path.max_load_factor / path.n_increments
+    step = nominal
+    prev = None        # (U, step) of the previous increment, for the secant predictor
     done: list[Increment] = []
     while lam_load < path.max_load_factor * (1 - 1e-12):
         step = min(step, path.max_load_factor - lam_load)
         target = lam_load + step
         t0 = time.perf_counter()
-        U_try, mu_try = U.copy(), mu.copy()
-        residuals, ok, negative = [], False, -1
-        scale = max(float(np.linalg.norm(target * Fv)), 1e-300)
-        R = internal_forces(q, mat, U_try).ravel() - target * Fv + C.T @ mu_try
-        for it in range(1, path.max_newton + 1):
-            K = regularize_ghosts(tangent_stiffness(q, mat, U_try), model)
-            dU, dmu, info = solve_augmented(K, -R, C, target * g - C @ U_try, settings.penalty,
-                                            settings.constraint_tol, method=settings.solver)
-            if not np.all(np.isfinite(dU)):
-                break
-            U_try += dU
-            mu_try += dmu
-            negative = info.negative_pivots
-            # the residual after the step (also the right-hand side of the next step); its
-            # scale: the applied load, or the reactions under displacement control (F = 0)
-            R = internal_forces(q, mat, U_try).ravel() - target * Fv + C.T @ mu_try
-            res = float(np.linalg.norm(R)) / max(scale, float(np.linalg.norm(C.T @ mu_try)))
-            residuals.append(res)
-            if log is not None:
-                log.info("  λ = %.5g  Newton %d: |R|/|λF| = %.3e  |ΔU| = %.3e", target, it, res,
-                         float(np.abs(dU).max()))
-            small_step = float(np.abs(dU).max()) <= 1e-10 * max(float(np.abs(U_try).max()),
-                                                                1e-300)
-            if res <= path.tol or (small_step and it >= 2):
-                ok = True
-                break
-        if not ok:
+        # secant predictor: extrapolate the last converged increment to the new load
+        guess = U if prev is None else U + (step / prev[1]) * (U - prev[0])
+        result = load_increment(eq, path, guess, mu, target, log)
+        if result is None and prev is not None:
+            result = load_increment(eq, path, U, mu, target, log)
+        if result is None:
             step *= 0.5
             if log is not None:
                 log.warning("increment to λ = %.5g did not converge; cutting the step to %.3g",
                             target, step)
-            if step < path.min_step * path.max_load_factor:
+            if step < path.min_step * nominal:
                 raise PathFollowingError(
                     f"the load path stopped at λ = {lam_load:.5g}: the increment could not be "
-                    f"cut below {path.min_step:g}·λ_max and still converge (a limit point or "
-                    "snap-through). The converged increments are saved. Use smaller steps "
-                    "(more increments), displacement control, or arc-length control.")
+                    f"cut below {path.min_step:g} of the nominal step and still converge (a "
+                    "limit point or snap-through). The converged increments are saved. Use "
+                    "smaller steps (more increments), displacement control, or arc-length "
+                    "control (study.control=arc_length).")
             continue
-        U, mu, lam_load = U_try, mu_try, target
-        e = energy(q, mat, U)
-        inc = Increment(lam_load, U.reshape(-1, 3).copy(), it, residuals, e, negative,
-                        negative == 0, time.perf_counter() - t0,
-                        support_reactions(C, mu, constraints.row_support))
-        done.append(inc)
+        prev = (U, step)
+        U, mu, it, residuals, negative = result
+        lam_load = target
+        done.append(make_increment(eq, U, mu, lam_load, it, residuals, negative, t0))
         if on_increment is not None:
-            on_increment(inc)
+            on_increment(done[-1])
         if it <= 4:  # converging easily: grow the step back towards its nominal size
-            step = min(2 * step, path.max_load_factor / path.n_increments)
+            step = min(2 * step, nominal)
     return done
+
+
+def make_increment(eq, U, mu, lam, iterations, residuals, negative, t0) -> Increment:
+    """The record of a converged state (energy split, stability, reactions)."""
+    return Increment(lam, U.reshape(-1, 3).copy(), iterations, residuals,
+                     eq.energy_parts(U), negative, negative == 0,
+                     time.perf_counter() - t0,
+                     support_reactions(eq.C, mu, eq.constraints.row_support))
+
+
+def load_increment(eq, path: PathSettings, U0, mu0, lam: float, log=None):
+    """Equilibrium at the load factor λ from (U0, μ0): L-BFGS stage then Newton with line
+    search. (U, μ, iterations, residuals, negative pivots), or None if it did not converge."""
+    U, mu = U0.copy(), mu0.copy()
+    if path.lbfgs_iterations > 0 and eq.rho is not None:
+        U, _ = eq.lbfgs(U, mu, lam, path.lbfgs_tol, path.lbfgs_iterations, log)
+    R, W = eq.residual(U, mu, lam)
+    residuals, negative = [], -1
+    for it in range(1, path.max_newton + 1):
+        sys = eq.system(U)
+        dU, dmu, _ = sys.solve(-R, lam * eq.g - eq.C @ U)
+        if not np.all(np.isfinite(dU)):
+            return None
+        negative = sys.negative_pivots
+        scale = eq.scale(lam, mu + dmu)
+        alpha, (R_new, W_new) = 1.0, eq.residual(U + dU, mu + dmu, lam)
+        if path.line_search and float(np.linalg.norm(R)) > 1e-3 * scale:
+            alpha, R_new, W_new = _line_search(eq, U, mu, dmu, lam, dU, R, W, R_new, W_new)
+        U, mu, R, W = U + alpha * dU, mu + dmu, R_new, W_new
+        res = float(np.linalg.norm(R)) / eq.scale(lam, mu)
+        residuals.append(res)
+        if log is not None:
+            log.info("  λ = %.5g  Newton %d: |R|/|λF| = %.3e  |ΔU| = %.3e%s", lam, it, res,
+                     float(np.abs(dU).max()), "" if alpha == 1.0 else f"  (step {alpha:.3g})")
+        if not np.isfinite(res):
+            return None
+        small_step = float(np.abs(dU).max()) <= 1e-10 * max(float(np.abs(U).max()), 1e-300)
+        if res <= path.tol or (small_step and it >= 2):
+            return U, mu, it, residuals, negative
+    return None
+
+
+def _line_search(eq, U, mu_old, dmu, lam, dU, R, W, R_new, W_new, c1: float = 1e-4,
+                 max_cuts: int = 5):
+    """Safeguarded Armijo backtracking on Π_ρ(U + α dU; μ, λ), μ = μ_old + dμ (App. E.2):
+    returns (α, R, W) at the accepted α. The full Newton step is kept when it reduces |R|,
+    when dU is not a descent direction (an unstable state) or when no cut decreases Π_ρ."""
+    if float(np.linalg.norm(R_new)) < float(np.linalg.norm(R)):
+        return 1.0, R_new, W_new   # the full step already reduces the out-of-balance force
+    mu = mu_old + dmu
+    c = eq.C @ U - lam * eq.g
+    grad = R + eq.C.T @ (dmu + (eq.rho or 0.0) * c)     # ∇Π_ρ(U; μ, λ)
+    slope = float(grad @ dU)
+    if not slope < 0:
+        return 1.0, R_new, W_new
+    phi0 = eq.merit(W, U, mu, lam)
+    alpha, R_a, W_a = 1.0, R_new, W_new
+    for _ in range(max_cuts + 1):
+        if eq.merit(W_a, U + alpha * dU, mu, lam) <= phi0 + c1 * alpha * slope:
+            return alpha, R_a, W_a
+        alpha *= 0.5
+        R_a, W_a = eq.residual(U + alpha * dU, mu, lam)
+    return 1.0, R_new, W_new

@@ -66,45 +66,67 @@ def factorize(A: csr_matrix, method: str = "direct"):
     return solve
 
 
+class ConstrainedSystem:
+    """K + ρCᵀC factorised once; :meth:`solve` then gives, for any right-hand side (F, g), the
+    minimiser of ½UᵀKU − FᵀU subject to CU = g and its multiplier (augmented Lagrangian).
+
+    The solution is linear in (F, g), so path-following (arc length, :mod:`.arc_length`)
+    combines two solves with one factorisation.
+    """
+
+    def __init__(self, K: csr_matrix, C: csr_matrix, penalty: float = 1e4, tol: float = 1e-10,
+                 max_iter: int = 200, method: str = "direct"):
+        t0 = time.perf_counter()
+        self.C, self.tol, self.max_iter = C, tol, max_iter
+        CtC = (C.T @ C).tocsr()
+        scale_c = CtC.diagonal().mean() if C.shape[0] else 0.0
+        self.rho = penalty * K.diagonal().mean() / scale_c if scale_c > 0 else 0.0
+        self._solve = factorize((K + self.rho * CtC).tocsr(), method)
+        self.negative_pivots = getattr(self._solve, "negative_pivots", -1)
+        self.factorize_time = time.perf_counter() - t0
+
+    def solve(self, F: np.ndarray, g: np.ndarray):
+        """(U, λ, SolveInfo) for min ½UᵀKU − FᵀU subject to CU = g."""
+        t1 = time.perf_counter()
+        C, rho, solve = self.C, self.rho, self._solve
+        # Dual problem S λ = C U_0 − g, S = C K_ρ⁻¹ Cᵀ (symmetric positive semi-definite,
+        # consistent even with redundant rows), by conjugate gradients: the multiplier update
+        # of the augmented Lagrangian, accelerated; one back-substitution per iteration.
+        U = solve(F + rho * (C.T @ g))
+        r = C @ U - g
+        lam = np.zeros(C.shape[0])
+        p = r.copy()
+        rr = float(r @ r)
+        viol = float(np.abs(r).max(initial=0.0))
+        it = 0
+        while viol > self.tol * max(np.abs(U).max(), 1e-300) and it < self.max_iter and rr > 0:
+            it += 1
+            W = solve(C.T @ p)
+            z = C @ W
+            pz = float(p @ z)
+            if not pz > 0:
+                break
+            alpha = rr / pz
+            lam += alpha * p
+            U -= alpha * W
+            r -= alpha * z
+            rr, rr_old = float(r @ r), rr
+            p = r + (rr / rr_old) * p
+            viol = float(np.abs(C @ U - g).max(initial=0.0))
+        if not np.all(np.isfinite(U)):
+            raise InputError("the solve produced NaN/inf: the problem is singular or badly "
+                             "scaled. Check the supports and that moduli and thickness are "
+                             "positive.")
+        t2 = time.perf_counter()
+        # the multiplier of the augmented Lagrangian is λ + ρ(CU − g) (reactions −Cᵀμ)
+        lam = lam + rho * (C @ U - g)
+        return U, lam, SolveInfo(max(it, 1), viol, rho, {"factorize": self.factorize_time,
+                                                         "iterate": t2 - t1},
+                                 self.negative_pivots)
+
+
 def solve_augmented(K: csr_matrix, F: np.ndarray, C: csr_matrix, g: np.ndarray,
                     penalty: float = 1e4, tol: float = 1e-10, max_iter: int = 200,
                     method: str = "direct"):
     """(U, λ, SolveInfo) for min ½UᵀKU − FᵀU subject to CU = g (augmented Lagrangian)."""
-    t0 = time.perf_counter()
-    CtC = (C.T @ C).tocsr()
-    scale_c = CtC.diagonal().mean() if C.shape[0] else 0.0
-    rho = penalty * K.diagonal().mean() / scale_c if scale_c > 0 else 0.0
-    solve = factorize((K + rho * CtC).tocsr(), method)
-    t1 = time.perf_counter()
-    # Dual problem S λ = C U_0 − g, S = C K_ρ⁻¹ Cᵀ (symmetric positive semi-definite,
-    # consistent even with redundant rows), by conjugate gradients: the multiplier update of
-    # the augmented Lagrangian, accelerated; one back-substitution per iteration.
-    U = solve(F + rho * (C.T @ g))
-    r = C @ U - g
-    lam = np.zeros(C.shape[0])
-    p = r.copy()
-    rr = float(r @ r)
-    viol = float(np.abs(r).max(initial=0.0))
-    it = 0
-    while viol > tol * max(np.abs(U).max(), 1e-300) and it < max_iter and rr > 0:
-        it += 1
-        W = solve(C.T @ p)
-        z = C @ W
-        pz = float(p @ z)
-        if not pz > 0:
-            break
-        alpha = rr / pz
-        lam += alpha * p
-        U -= alpha * W
-        r -= alpha * z
-        rr, rr_old = float(r @ r), rr
-        p = r + (rr / rr_old) * p
-        viol = float(np.abs(C @ U - g).max(initial=0.0))
-    if not np.all(np.isfinite(U)):
-        raise InputError("the solve produced NaN/inf: the problem is singular or badly scaled. "
-                         "Check the supports and that moduli and thickness are positive.")
-    t2 = time.perf_counter()
-    # the multiplier of the augmented Lagrangian is λ + ρ(CU − g) (reaction forces −Cᵀμ)
-    lam = lam + rho * (C @ U - g)
-    return U, lam, SolveInfo(max(it, 1), viol, rho, {"factorize": t1 - t0, "iterate": t2 - t1},
-                             getattr(solve, "negative_pivots", -1))
+    return ConstrainedSystem(K, C, penalty, tol, max_iter, method).solve(F, g)

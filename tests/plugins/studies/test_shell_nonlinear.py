@@ -29,3 +29,49 @@ def test_open_hemisphere_path_and_resume(tmp_path, run_cli):
     assert r.returncode == 0, r.stderr[-2000:]
     resumed = open_run(next((tmp_path / "out2").glob("runs/*/*")))
     assert resumed["load_factor"].values.tolist() == pytest.approx([0.1, 0.15])
+
+
+def test_first_crossing_reports_what_force_control_sees():
+    import numpy as np
+
+    from pointatlas_studies.shell_nonlinear import first_crossing
+
+    # a path over a limit point at λ = 0.5, down to 0.3, and up again to 1
+    lam = [0.25, 0.5, 0.4, 0.3, 0.6, 1.0]
+    w = [1.0, 2.0, 2.5, 3.0, 4.0, 5.0]
+    got = first_crossing([0.25, 0.45, 0.55, 1.0, 1.2], lam, w)
+    assert got[:4] == pytest.approx([1.0, 1.8, 3.0 + 0.25 / 0.3, 5.0])
+    assert np.isnan(got[4])
+
+
+def test_nonlinear_run_on_a_vtp_point_cloud_needs_no_code(tmp_path, run_cli):
+    """The open hemisphere's points as a .vtp file, supports, loads and monitors given only
+    on the command line: the same path as the built-in experiment (Sze et al. at 0.1 P_max)."""
+    import numpy as np
+    import pyvista as pv
+
+    import pointatlas
+
+    cloud = pointatlas.load_plugin("sources", "hemisphere")(
+        n_points=200, model="quarter", hole_angle_deg=18.0).load(np.random.default_rng(0))
+    pv.PolyData(cloud.points).save(str(tmp_path / "shell.vtp"))
+    supports = ("[{kind:symmetry,normal:[1,0,0],where:{plane:[1,0,0,0]}},"
+                "{kind:symmetry,normal:[0,1,0],where:{plane:[0,1,0,0]}},"
+                "{kind:fixed,components:[2],where:{expression:'z > 9.4 and abs(y) < 1e-6'}}]")
+    loads = "[{kind:point,at:[10,0,0],force:[200,0,0]},{kind:point,at:[0,10,0],force:[0,-200,0]}]"
+    r = run_cli("pointatlas", "~experiment", "source=file", f"source.path={tmp_path}/shell.vtp",
+                "embedder=pca", "physics=kirchhoff_love", "study=shell_nonlinear",
+                "physics.young_modulus=6.825e7", "physics.thickness=0.04",
+                f"physics.supports={supports}", f"physics.loads={loads}",
+                "study.quadrature_order=4", "study.n_increments=2", "study.max_load_factor=0.1",
+                "study.full_load=400", "study.monitor_points=[10,0,0,0,10,0]",
+                "study.monitor_directions=[1,0,0,0,-1,0]", "study.monitor_names=[A,B]",
+                "study.monitor_magnitude=true", f"outputs_root={tmp_path}/out", "quiet=true",
+                cwd=tmp_path)
+    assert r.returncode == 0, r.stderr[-2000:]
+    ds = open_run(next((tmp_path / "out").glob("runs/*/*")))
+    a, b = ds["displacement_at"].values[-1]
+    # 200 points without the source's markers (the built-in run gives 1.40 / 1.68)
+    assert a == pytest.approx(1.499, rel=0.15) and b == pytest.approx(1.840, rel=0.15)
+    assert ds["energy_density"].dims == ("increment", "sample")
+    assert float(ds["energy_density"].min()) >= 0 and float(ds["energy_density"].max()) > 0

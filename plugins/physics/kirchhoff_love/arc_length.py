@@ -1,0 +1,129 @@
+"""Arc-length continuation (Crisfield's cylindrical method) for nonlinear shells.
+
+Paper 2 §5 follows snap-through (pull-out cylinder) and buckling paths; under force control
+Newton fails at a limit point dλ/ds = 0. Here λ is an unknown, and each increment adds the
+constraint that the displacement increment has a prescribed length Δs (Crisfield 1981,
+"A fast incremental/iterative solution procedure that handles snap-through", Comput.
+Struct. 13:55–62, the cylindrical variant):
+
+    |ΔU|² = Δs²,   ΔU = U − U_k.
+
+The loads λF and the imposed displacements λg both scale with λ. Each iteration solves, with
+one factorisation of K_T + ρCᵀC (:class:`.solver.ConstrainedSystem`), the two constrained
+problems
+
+    K δU_R + Cᵀ δμ_R = −R,  C δU_R = λg − CU;      K δU_F + Cᵀ δμ_F = F,  C δU_F = g,
+
+and δU = δU_R + δλ δU_F with δλ the root of a δλ² + b δλ + c = 0 (a = |δU_F|²,
+b = 2 δU_F·(ΔU + δU_R), c = |ΔU + δU_R|² − Δs²) that keeps ΔU closest in direction to the
+previous iterate. The predictor follows the tangent δU_F with the sign of ΔU_prev·δU_F
+(so the path continues through limit points). Δs adapts to the Newton iterations
+(×sqrt(desired/it), within [½, 2] per increment and at most the initial Δs); a failed
+increment (no real root, NaN, too many iterations) halves Δs and retries.
+"""
+from __future__ import annotations
+
+import time
+from typing import Optional
+
+import numpy as np
+
+from .incremental import (Increment, PathFollowingError, PathSettings, load_increment,
+                          make_increment)
+
+
+def arc_increment(eq, path: PathSettings, U0, mu0, lam0: float, ds: float, dU_prev, log=None):
+    """One arc-length increment of length ds from the converged (U0, μ0, λ0).
+
+    Returns (U, μ, λ, iterations, residuals, negative pivots) or None if it failed."""
+    sys = eq.system(U0)
+    dUF, dmuF, _ = sys.solve(eq.F, eq.g)
+    nF = float(np.linalg.norm(dUF))
+    if not (np.isfinite(nF) and nF > 0):
+        return None
+    sign = 1.0 if dU_prev is None or float(dU_prev @ dUF) >= 0 else -1.0
+    dlam = sign * ds / nF
+    DU, Dmu, lam = dlam * dUF, dlam * dmuF, lam0 + dlam
+    residuals, negative = [], sys.negative_pivots
+    R, _ = eq.residual(U0 + DU, mu0 + Dmu, lam)
+    for it in range(1, path.max_newton + 1):
+        U = U0 + DU
+        sys = eq.system(U)
+        dUR, dmuR, _ = sys.solve(-R, lam * eq.g - eq.C @ U)
+        dUF, dmuF, _ = sys.solve(eq.F, eq.g)
+        a = float(dUF @ dUF)
+        w = DU + dUR
+        b, c = 2.0 * float(dUF @ w), float(w @ w) - ds * ds
+        disc = b * b - 4 * a * c
+        if not (a > 0 and disc >= 0 and np.isfinite(disc)):
+            if log is not None:
+                log.warning("  arc length: no real root for δλ (Δs too large here)")
+            return None
+        roots = ((-b + np.sqrt(disc)) / (2 * a), (-b - np.sqrt(disc)) / (2 * a))
+        r = max(roots, key=lambda t: float((w + t * dUF) @ DU))
+        step = dUR + r * dUF
+        DU, Dmu, lam = DU + step, Dmu + dmuR + r * dmuF, lam + r
+        negative = sys.negative_pivots
+        U, mu = U0 + DU, mu0 + Dmu
+        R, _ = eq.residual(U, mu, lam)
+        res = float(np.linalg.norm(R)) / eq.scale(lam, mu)
+        residuals.append(res)
+        if log is not None:
+            log.info("  arc length: λ = %.5g  Newton %d: |R|/|λF| = %.3e  |δU| = %.3e", lam,
+                     it, res, float(np.abs(step).max()))
+        if not np.isfinite(res):
+            return None
+        if res <= path.tol:
+            return U, mu, lam, it, residuals, negative
+    return None
+
+
+def follow_arc_length(eq, path: PathSettings, on_increment=None, log=None,
+                      start: Optional[Increment] = None) -> list[Increment]:
+    """Arc-length increments from λ = 0 (or ``start``) until λ ≥ ``path.max_load_factor``;
+    the last increment is brought back to exactly λ_max by a load-controlled solve."""
+    U = np.zeros(eq.F.size) if start is None else start.U.ravel().copy()
+    lam = 0.0 if start is None else start.load_factor
+    mu = np.zeros(eq.C.shape[0])
+    nominal = path.max_load_factor / path.n_increments
+    dUF, _, _ = eq.system(U).solve(eq.F, eq.g)
+    ds0 = nominal * float(np.linalg.norm(dUF))
+    if not (np.isfinite(ds0) and ds0 > 0):
+        raise PathFollowingError("arc length: the load (F, g) produces no displacement; give a "
+                                 "load or an imposed displacement.")
+    ds, dU_prev, done = ds0, None, []
+    while lam < path.max_load_factor * (1 - 1e-12):
+        if len(done) >= path.max_increments:
+            raise PathFollowingError(
+                f"arc length: λ = {lam:.5g} after {len(done)} increments without reaching "
+                f"λ_max = {path.max_load_factor:g}. The converged increments are saved. "
+                "Raise study.max_increments or use larger steps (fewer study.n_increments).")
+        t0 = time.perf_counter()
+        result = arc_increment(eq, path, U, mu, lam, ds, dU_prev, log)
+        if result is None:
+            ds *= 0.5
+            if log is not None:
+                log.warning("arc-length increment from λ = %.5g did not converge; Δs → %.3g",
+                            lam, ds)
+            if ds < path.min_step * ds0:
+                raise PathFollowingError(
+                    f"arc length: the path stopped at λ = {lam:.5g}: the arc could not be cut "
+                    f"below {path.min_step:g} of the initial one and still converge (a "
+                    "bifurcation or a very sharp turn). The converged increments are saved. "
+                    "Use more increments or a finer point set.")
+            continue
+        U_new, mu_new, lam_new, it, residuals, negative = result
+        if lam_new > path.max_load_factor:
+            # land on λ_max exactly, from the last converged state
+            exact = load_increment(eq, path, U, mu, path.max_load_factor, log)
+            if exact is not None:
+                U_new, mu_new, it, residuals, negative = exact
+                lam_new = path.max_load_factor
+        dU_prev = U_new - U
+        U, mu, lam = U_new, mu_new, lam_new
+        done.append(make_increment(eq, U, mu, lam, it, residuals, negative, t0))
+        if on_increment is not None:
+            on_increment(done[-1])
+        ds = min(ds * float(np.clip(np.sqrt(path.desired_iterations / max(it, 1)), 0.5, 2.0)),
+                 ds0)
+    return done

@@ -1,0 +1,106 @@
+"""The equilibrium equations of a loaded, supported nonlinear shell at a load factor λ.
+
+Thesis §4.4, App. E.2 (L3669–3700) and Paper 2 App. E: with the geometrically exact energy W
+(:mod:`.nonlinear`), external loads λF and supports CU = λg (loads and imposed displacements
+are both scaled by λ), the augmented Lagrangian of the total potential is
+
+    Π_ρ(U; μ, λ) = W(U) − λFᵀU + μᵀ(CU − λg) + ½ρ|CU − λg|²,
+
+whose gradient at ρ-feasible points is the out-of-balance force R = f_int(U) − λF + Cᵀμ.
+:class:`Equilibrium` evaluates R and Π_ρ (one numba pass gives both), factorises the
+constrained tangent K_T + ρCᵀC (:class:`.solver.ConstrainedSystem`, whose pivot signs flag
+unstable equilibria), and runs the coarse L-BFGS stage that precedes Newton (thesis L2301:
+"we first obtain a coarse and robust approximation of the equilibrium point with a
+limited-memory BFGS method and then switch to Newton's method combined with line search").
+"""
+from __future__ import annotations
+
+import numpy as np
+
+
+class Equilibrium:
+    """R(U, μ, λ), Π_ρ(U; μ, λ), the constrained tangent and the L-BFGS stage of one shell."""
+
+    def __init__(self, model, settings, F: np.ndarray, constraints):
+        self.model, self.settings = model, settings
+        self.q, self.mat = model.quadrature, model.material
+        self.C, self.g = constraints.matrix, constraints.rhs
+        self.F = np.asarray(F, dtype=float).ravel()
+        self.constraints = constraints
+        self.rho = None   # set by the first factorisation (scale free, from diag K)
+        # the weak ghost springs of the linear analysis, frozen and part of the energy
+        # (½ sᵀU², force sU), so that Newton's fixed point and its tangent agree and the
+        # nearly free far ghost DOFs do not drift from one iteration to the next
+        from .analysis import ghost_springs
+        from .linear import linear_stiffness
+
+        self.springs = ghost_springs(linear_stiffness(self.q, self.mat), model)
+
+    def energy_and_forces(self, U: np.ndarray):
+        """(W, f_int): strain energy (energy) and internal forces (force), one kernel pass."""
+        from .assembly import densities_and_forces
+
+        dens, f = densities_and_forces(self.q, self.mat, U.reshape(-1, 3), True)
+        U = U.ravel()
+        W = float((self.q.weights @ dens).sum()) + 0.5 * float(self.springs @ (U * U))
+        return W, f.ravel() + self.springs * U
+
+    def energy_parts(self, U) -> dict:
+        """{'total', 'membrane', 'bending'} strain energy at U (energy)."""
+        from .nonlinear import energy
+
+        return energy(self.q, self.mat, U.reshape(-1, 3))
+
+    def residual(self, U, mu, lam):
+        """(R, W): out-of-balance force f_int(U) − λF + Cᵀμ and the strain energy."""
+        W, f = self.energy_and_forces(U)
+        return f - lam * self.F + self.C.T @ mu, W
+
+    def scale(self, lam, mu) -> float:
+        """Force scale of the residual: the applied load, or the reactions when F = 0."""
+        return max(float(np.linalg.norm(lam * self.F)), float(np.linalg.norm(self.C.T @ mu)),
+                   1e-300)
+
+    def merit(self, W, U, mu, lam) -> float:
+        """Π_ρ(U; μ, λ) given W = W(U) (energy)."""
+        c = self.C @ U - lam * self.g
+        return W - lam * float(self.F @ U) + float(mu @ c) + 0.5 * (self.rho or 0.0) * float(c @ c)
+
+    def system(self, U):
+        """The factorised constrained tangent K_T(U) + ρCᵀC (:class:`ConstrainedSystem`)."""
+        from scipy.sparse import diags
+
+        from .nonlinear import tangent_stiffness
+        from .solver import ConstrainedSystem
+
+        K = (tangent_stiffness(self.q, self.mat, U.reshape(-1, 3)) + diags(self.springs)).tocsr()
+        sys = ConstrainedSystem(K, self.C, self.settings.penalty, self.settings.constraint_tol,
+                                method=self.settings.solver)
+        self.rho = sys.rho
+        return sys
+
+    def lbfgs(self, U, mu, lam, rel_tol: float, max_iter: int, log=None):
+        """Coarse minimisation of Π_ρ(·; μ, λ) by L-BFGS from U, to a gradient of rel_tol
+        times the load scale (the robust first stage of App. E.2). Returns (U, iterations)."""
+        from scipy.optimize import minimize
+
+        if self.rho is None or max_iter <= 0:
+            return U, 0
+        rho, C, g = self.rho, self.C, self.g
+
+        def fun(x):
+            W, f = self.energy_and_forces(x)
+            c = C @ x - lam * g
+            grad = f - lam * self.F + C.T @ (mu + rho * c)
+            return self.merit(W, x, mu, lam), grad
+
+        scale = self.scale(lam, mu)
+        res = minimize(fun, U, jac=True, method="L-BFGS-B",
+                       options={"maxiter": max_iter, "gtol": rel_tol * scale / np.sqrt(U.size),
+                                "maxcor": 20})
+        if not np.all(np.isfinite(res.x)) or not res.fun <= fun(U)[0]:
+            return U, int(res.nit)
+        if log is not None:
+            log.info("  λ = %.5g  L-BFGS: %d iterations, |∇Π| = %.3e", lam, res.nit,
+                     float(np.linalg.norm(res.jac)) / scale)
+        return res.x, int(res.nit)

@@ -1,0 +1,79 @@
+"""Arc length passes a snap-through that stops force control (a one-DOF spring with a
+cubic force law f(u) = u − 1.5u² + 0.6u³: limit points at u = (3 ∓ √1.8)/3.6)."""
+import numpy as np
+import pytest
+from scipy.sparse import csr_matrix
+
+from pointatlas_physics.kirchhoff_love.arc_length import follow_arc_length
+from pointatlas_physics.kirchhoff_love.incremental import PathFollowingError, PathSettings
+from pointatlas_physics.kirchhoff_love.solver import ConstrainedSystem
+
+
+def force(u):
+    return u - 1.5 * u**2 + 0.6 * u**3
+
+
+class CubicSpring:
+    """The Equilibrium interface for U = (u, v, w) with W = ∫f(u) + ½(v² + w²), v = w = 0
+    held by two constraint rows and a load F = (1, 0, 0)."""
+
+    def __init__(self):
+        self.F = np.array([1.0, 0.0, 0.0])
+        self.C = csr_matrix(np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]))
+        self.g = np.zeros(2)
+        self.rho = None
+        self.constraints = type("Cons", (), {"row_support": np.zeros(2, dtype=int)})()
+
+    def residual(self, U, mu, lam):
+        u = U[0]
+        W = u**2 / 2 - 0.5 * u**3 + 0.15 * u**4 + 0.5 * (U[1] ** 2 + U[2] ** 2)
+        f = np.array([force(u), U[1], U[2]])
+        return f - lam * self.F + self.C.T @ mu, W
+
+    def energy_parts(self, U):
+        W = self.residual(U, np.zeros(2), 0.0)[1]
+        return {"total": W, "membrane": W, "bending": 0.0}
+
+    def scale(self, lam, mu):
+        return max(abs(lam), float(np.linalg.norm(self.C.T @ mu)), 1e-300)
+
+    def merit(self, W, U, mu, lam):
+        return W - lam * float(self.F @ U)
+
+    def system(self, U):
+        K = csr_matrix(np.diag([1 - 3 * U[0] + 1.8 * U[0] ** 2, 1.0, 1.0]))
+        sys = ConstrainedSystem(K, self.C, 1e3, 1e-12)
+        self.rho = sys.rho
+        return sys
+
+
+def test_arc_length_passes_the_limit_points_and_reaches_the_load():
+    path = PathSettings(n_increments=10, max_load_factor=1.0, tol=1e-10, max_newton=15)
+    incs = follow_arc_length(CubicSpring(), path)
+    lam = np.array([i.load_factor for i in incs])
+    u = np.array([i.U.ravel()[0] for i in incs])
+    # every converged point is on the equilibrium curve
+    assert np.allclose(force(u), lam, atol=1e-9)
+    # it went over the first limit point (λ = 0.201) and came down the unstable branch
+    assert lam.max() == pytest.approx(1.0) and np.any(np.diff(lam) < 0)
+    unstable = [i for i in incs if not i.stable]
+    lower, upper = (3 - np.sqrt(1.8)) / 3.6, (3 + np.sqrt(1.8)) / 3.6
+    assert unstable and all(lower < i.U.ravel()[0] < upper for i in unstable)
+    assert all(i.stable for i in incs if not lower < i.U.ravel()[0] < upper)
+    # and it ends at λ = 1 exactly, on the far stable branch
+    assert lam[-1] == 1.0 and u[-1] > upper and force(u[-1]) == pytest.approx(1.0, abs=1e-9)
+
+
+def test_force_control_jumps_over_the_unstable_branch(monkeypatch):
+    """Minimising at each load, force control snaps from the first stable branch to the far
+    one (what a dynamic snap-through does) and never sees the unstable states."""
+    import pointatlas_physics.kirchhoff_love.equilibrium as equilibrium
+    from pointatlas_physics.kirchhoff_love.incremental import follow_path
+
+    monkeypatch.setattr(equilibrium, "Equilibrium", lambda *a, **k: CubicSpring())
+    incs = follow_path(None, None, PathSettings(n_increments=10, tol=1e-10), None, None)
+    u = np.array([i.U.ravel()[0] for i in incs])
+    lower, upper = (3 - np.sqrt(1.8)) / 3.6, (3 + np.sqrt(1.8)) / 3.6
+    assert all(i.stable for i in incs) and not np.any((u > lower) & (u < upper))
+    assert u[1] < lower < upper < u[2]  # λ = 0.2 before the limit point 0.201, 0.3 after
+    assert force(u[-1]) == pytest.approx(1.0, abs=1e-9)

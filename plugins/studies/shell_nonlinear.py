@@ -52,6 +52,8 @@ class ShellPathSettings(ShellStudySettings):
     reference_load_factors: List[float] = field(default_factory=list)
     reference_values: List[float] = field(default_factory=list)     # row per monitored point
     reference_label: str = ""
+    reference_split_level: Optional[float] = None   # errors also before/after this level
+    monitor_variables: List[str] = field(default_factory=list)  # also one variable per point
     resume_from: Optional[str] = None
 
 
@@ -79,6 +81,10 @@ class ShellNonlinearStudy:
         if not (len(P) == len(E) == len(names)) or len(P) == 0:
             raise ConfigError("study.monitor_points, monitor_directions (3 numbers per point) "
                               "and monitor_names must describe the same ≥ 1 points.")
+        if self.monitor_variables and len(self.monitor_variables) != len(names):
+            raise ConfigError(f"study.monitor_variables has {len(self.monitor_variables)} "
+                              f"names for {len(names)} monitored points: give one per point "
+                              "or none.")
         return P, E / np.linalg.norm(E, axis=1)[:, None], names
 
     def run(self, ctx):
@@ -192,78 +198,11 @@ class ShellNonlinearStudy:
         return Increment(lam, U, 0, [], {}, -1, True, 0.0)
 
     def _dataset(self, model, records, values, names):
-        import xarray as xr
+        from .shell_path_results import path_dataset
 
-        mon = np.asarray(values, dtype=float).reshape(len(records), len(names))
-        if self.monitor_magnitude:
-            mon = np.abs(mon)
-        lam = np.array([r.load_factor for r in records])
-        one = {"units": "1"}
-        reactions = [r.reactions for r in records if r.reactions is not None]
         pairs = [self._load(r.load_factor, r.reactions) for r in records]
-        load = np.array([p[0] for p in pairs], dtype=float)
-        load_name = pairs[-1][1] if pairs else "load"
-        data = {
-            "load_factor": (("increment",), lam, {**one, "long_name": "load factor λ"}),
-            "load": (("increment",), load, {"long_name": load_name, "units": "force"}),
-            self.monitor_variable: (("increment", "point"), mon, {
-                "long_name": "displacement at the monitored point along its direction"
-                             + (" (magnitude)" if self.monitor_magnitude else ""),
-                "units": "length"}),
-            "newton_iterations": (("increment",), [r.iterations for r in records], {
-                **one, "long_name": "Newton iterations"}),
-            "stable": (("increment",), np.array([r.stable for r in records], np.int8), {
-                **one, "long_name": "1 if no negative pivot of the constrained tangent"}),
-            "increment_time": (("increment",), [r.seconds for r in records], {
-                "long_name": "wall time of the increment", "units": "s"}),
-            "dof": ((), model.dof, {**one, "long_name": "degrees of freedom"}),
-        }
-        if reactions and len(reactions) == len(records):
-            data["reaction"] = (("increment", "support", "dim"), np.stack(reactions), {
-                "long_name": "resultant force each support exerts on the shell",
-                "units": "force"})
-        if len(self._fields) == len(records) and records:
-            u = np.stack([f[0] for f in self._fields])
-            w = np.stack([f[1] for f in self._fields])
-            data["position"] = (("sample", "dim"), self._points, {
-                "long_name": "sampled point x_a (reference configuration)", "units": "length"})
-            data["displacement_field"] = (("increment", "sample", "dim"), u, {
-                "long_name": "displacement u(x_a) at the sampled points", "units": "length"})
-            data["energy_density"] = (("increment", "sample"), w[:, :, 2], {
-                "long_name": "strain energy per unit reference area (membrane + bending)",
-                "units": "energy/length²"})
-            data["bending_fraction"] = (("increment", "sample"), w[:, :, 1] / np.where(
-                w[:, :, 2] > 0, w[:, :, 2], 1.0), {
-                "units": "1", "long_name": "bending share of the energy density"})
-        for part in ("membrane", "bending", "total"):
-            data[f"energy_{part}"] = (("increment",), [r.energy.get(part, np.nan)
-                                                       for r in records],
-                                      {"long_name": f"{part} strain energy", "units": "energy"})
-        ds = xr.Dataset(data, coords={
-            "increment": ("increment", np.arange(len(records)), {**one,
-                                                                 "long_name": "increment"}),
-            "point": ("point", names, {**one, "long_name": "monitored point"}),
-            "dim": ("dim", ["x", "y", "z"], {**one, "long_name": "Cartesian component"}),
-            "sample": ("sample", np.arange(len(self._points)), {
-                **one, "long_name": "sampled point index"})})
-        if "reaction" in ds:
-            ds = ds.assign_coords(support=("support", np.arange(ds.sizes["support"]), {
-                **one, "long_name": "index into physics.supports"}))
-        if self.reference_load_factors and len(records):
-            ref = np.asarray(self.reference_values, float).reshape(len(names), -1)
-            lf = np.asarray(self.reference_load_factors, float)
-            ours = np.array([first_crossing(lf, lam, mon[:, j]) for j in range(len(names))])
-            err = np.abs(ours - ref) / np.abs(ref)
-            ds = ds.assign_coords(reference_level=("reference_level", lf, {
-                **one, "long_name": "tabulated load factor"}))
-            ds["reference_curve"] = (("point", "reference_level"), ref, {
-                "long_name": f"published values ({self.reference_label})", "units": "length"})
-            ds["relative_error_curve"] = (("point", "reference_level"), err, {
-                **one, "long_name": "|ours − published| / |published| at tabulated levels"})
-            ds["max_relative_error"] = ((), float(np.nanmax(err)) if np.isfinite(err).any()
-                                        else np.nan, {**one, "long_name":
-                                                      "largest relative error over the table"})
-        return ds
+        return path_dataset(self, model.dof, self._points, records, values, names,
+                            self._fields, pairs)
 
     def _write(self, path: Path, model, records, values, names):
         """increments.nc with all converged increments (temporary file, then rename)."""
@@ -278,38 +217,9 @@ class ShellNonlinearStudy:
 
     @staticmethod
     def report_figures(ds):
-        from matplotlib.figure import Figure
+        from .shell_path_results import path_figures
 
-        var = [v for v in ds.data_vars if ds[v].dims == ("increment", "point")][0]
-        fig = Figure(figsize=(5.6, 4.0), layout="constrained")
-        ax = fig.add_subplot()
-        for j, name in enumerate(ds["point"].values):
-            ax.plot(ds[var].values[:, j], ds["load"].values, "o-", ms=3, label=f"{name}")
-            if "reference_curve" in ds:
-                ax.plot(ds["reference_curve"].values[j],
-                        ds["reference_level"].values * float(ds["load"].values[-1]
-                                                             / ds["load_factor"].values[-1]),
-                        "ks", mfc="none", ms=5, label=f"{name} published" if j == 0 else None)
-        ax.set_xlabel(f"{var} (length)")
-        ax.set_ylabel("load")
-        ax.legend(fontsize=8)
-        figures = [("Load–deflection curves" + (f" (max rel. error vs published "
-                                                 f"{float(ds['max_relative_error']):.2%})"
-                                                 if "max_relative_error" in ds else ""), fig)]
-        if "energy_density" in ds and ds.sizes["increment"]:
-            from pointatlas_physics.kirchhoff_love.snapshots import (pick_snapshots,
-                                                                     snapshot_figure)
-
-            picks = pick_snapshots(ds.sizes["increment"], 4)
-            x = ds["position"].values
-            figures.append((
-                "Deformed configurations (not magnified) coloured by strain energy density",
-                snapshot_figure(
-                    x, [ds["displacement_field"].values[k] for k in picks],
-                    [ds["energy_density"].values[k] for k in picks],
-                    [f"increment {k + 1}: load {float(ds['load'].values[k]):.4g}"
-                     for k in picks])))
-        return figures
+        return path_figures(ds)
 
 
 def point_fields(model):
@@ -322,24 +232,6 @@ def point_fields(model):
     B = basis.to_csr(model.nodes.shape[0])
     energy_at = point_energy_operator(model)
     return lambda U: (B @ np.asarray(U).reshape(-1, 3), energy_at(U))
-
-
-def first_crossing(levels, lam, values) -> np.ndarray:
-    """values interpolated at each load level where the path λ(increment) first reaches it
-    (NaN if never): what force control would report, even when an arc-length path turns
-    back at a limit point (the later crossings of a level lie on the unstable branch and on
-    the branch the snap-through lands on; the table lists the first)."""
-    lam = np.concatenate([[0.0], np.asarray(lam, float)])
-    values = np.concatenate([[0.0], np.asarray(values, float)])
-    out = np.full(len(levels), np.nan)
-    for i, level in enumerate(levels):
-        for k in range(len(lam) - 1):
-            a, b = lam[k], lam[k + 1]
-            if b > a and a <= level <= b:
-                t = (level - a) / (b - a)
-                out[i] = (1 - t) * values[k] + t * values[k + 1]
-                break
-    return out
 
 
 def monitor_operator(model, P: np.ndarray, E: np.ndarray):

@@ -2,7 +2,8 @@
 
 Paper 2 §5 follows snap-through (pull-out cylinder) and buckling paths; under force control
 Newton fails at a limit point dλ/ds = 0. Here λ is an unknown, and each increment adds the
-constraint that the displacement increment has a prescribed length Δs (Crisfield 1981,
+constraint that the displacement increment of the surface's control points (ghost nodes
+excluded, :func:`arc_mask`) has a prescribed length Δs (Crisfield 1981,
 "A fast incremental/iterative solution procedure that handles snap-through", Comput.
 Struct. 13:55–62, the cylindrical variant):
 
@@ -16,9 +17,12 @@ problems
 
 and δU = δU_R + δλ δU_F with δλ the root of a δλ² + b δλ + c = 0 (a = |δU_F|²,
 b = 2 δU_F·(ΔU + δU_R), c = |ΔU + δU_R|² − Δs²) that keeps ΔU closest in direction to the
-previous iterate. The predictor follows the tangent δU_F with the sign of ΔU_prev·δU_F
+previous iterate (when there is no real root, the minimiser −b/2a of the quadratic). The
+predictor follows the tangent δU_F with the sign of ΔU_prev·δU_F
 (so the path continues through limit points). Δs adapts to the Newton iterations
-(×sqrt(desired/it), within [½, 2] per increment and at most the initial Δs); a failed
+(×sqrt(desired/it), within [½, 2] per increment and at most Δs₀, the length of the first
+increment, which is load controlled; an increment whose |Δλ| exceeds 1.5 nominal steps is
+redone with a proportionally shorter arc); a failed
 increment (no real root, NaN, too many iterations) halves Δs and retries.
 """
 from __future__ import annotations
@@ -32,16 +36,28 @@ from .incremental import (Increment, PathFollowingError, PathSettings, load_incr
                           make_increment)
 
 
+def arc_mask(eq, n_dofs: int) -> np.ndarray:
+    """1 on the DOFs of the sampled points, 0 on ghost DOFs: the arc length is measured on
+    the control points of the surface only (far ghost nodes are nearly free and would
+    dominate |ΔU| with motions that do not change the shell)."""
+    model = getattr(eq, "model", None)
+    n_real = n_dofs if model is None else 3 * model.points.shape[0]
+    m = np.zeros(n_dofs)
+    m[:n_real] = 1.0
+    return m
+
+
 def arc_increment(eq, path: PathSettings, U0, mu0, lam0: float, ds: float, dU_prev, log=None):
     """One arc-length increment of length ds from the converged (U0, μ0, λ0).
 
     Returns (U, μ, λ, iterations, residuals, negative pivots) or None if it failed."""
+    m = arc_mask(eq, U0.size)
     sys = eq.system(U0)
     dUF, dmuF, _ = sys.solve(eq.F, eq.g)
-    nF = float(np.linalg.norm(dUF))
+    nF = float(np.linalg.norm(m * dUF))
     if not (np.isfinite(nF) and nF > 0):
         return None
-    sign = 1.0 if dU_prev is None or float(dU_prev @ dUF) >= 0 else -1.0
+    sign = 1.0 if dU_prev is None or float(dU_prev @ (m * dUF)) >= 0 else -1.0
     dlam = sign * ds / nF
     DU, Dmu, lam = dlam * dUF, dlam * dmuF, lam0 + dlam
     residuals, negative = [], sys.negative_pivots
@@ -51,16 +67,20 @@ def arc_increment(eq, path: PathSettings, U0, mu0, lam0: float, ds: float, dU_pr
         sys = eq.system(U)
         dUR, dmuR, _ = sys.solve(-R, lam * eq.g - eq.C @ U)
         dUF, dmuF, _ = sys.solve(eq.F, eq.g)
-        a = float(dUF @ dUF)
+        a = float(dUF @ (m * dUF))
         w = DU + dUR
-        b, c = 2.0 * float(dUF @ w), float(w @ w) - ds * ds
+        b, c = 2.0 * float(dUF @ (m * w)), float(w @ (m * w)) - ds * ds
         disc = b * b - 4 * a * c
-        if not (a > 0 and disc >= 0 and np.isfinite(disc)):
-            if log is not None:
-                log.warning("  arc length: no real root for δλ (Δs too large here)")
+        if not (a > 0 and np.isfinite(disc)):
             return None
-        roots = ((-b + np.sqrt(disc)) / (2 * a), (-b - np.sqrt(disc)) / (2 * a))
-        r = max(roots, key=lambda t: float((w + t * dUF) @ DU))
+        if disc >= 0:
+            roots = ((-b + np.sqrt(disc)) / (2 * a), (-b - np.sqrt(disc)) / (2 * a))
+            r = max(roots, key=lambda t: float((w + t * dUF) @ (m * DU)))
+        else:
+            # no real root (the sphere |ΔU| = Δs is missed near a sharp turn): take the
+            # point of the line closest to it, δλ = −b/2a, and let the next iterations
+            # restore the constraint (Lam & Morley 1992)
+            r = -b / (2 * a)
         step = dUR + r * dUF
         DU, Dmu, lam = DU + step, Dmu + dmuR + r * dmuF, lam + r
         negative = sys.negative_pivots
@@ -86,12 +106,33 @@ def follow_arc_length(eq, path: PathSettings, on_increment=None, log=None,
     lam = 0.0 if start is None else start.load_factor
     mu = np.zeros(eq.C.shape[0])
     nominal = path.max_load_factor / path.n_increments
-    dUF, _, _ = eq.system(U).solve(eq.F, eq.g)
-    ds0 = nominal * float(np.linalg.norm(dUF))
+    mask = arc_mask(eq, U.size)
+    done: list[Increment] = []
+    # the first increment is load controlled; its length |ΔU| is the arc length Δs₀ (the
+    # linear predictor overestimates the response of a stiffening shell by orders of
+    # magnitude, and a sphere of that radius may never meet the path)
+    step = nominal
+    while True:
+        t0 = time.perf_counter()
+        first = load_increment(eq, path, U, mu, lam + step, log)
+        if first is not None:
+            break
+        step *= 0.5
+        if step < path.min_step * nominal:
+            raise PathFollowingError(
+                f"arc length: the first increment from λ = {lam:.5g} did not converge even "
+                f"at {step / nominal:.3g} of the nominal step. Use more increments.")
+    U_new, mu_new, it, residuals, negative = first
+    dU_prev = mask * (U_new - U)
+    ds0 = float(np.linalg.norm(dU_prev))
     if not (np.isfinite(ds0) and ds0 > 0):
         raise PathFollowingError("arc length: the load (F, g) produces no displacement; give a "
                                  "load or an imposed displacement.")
-    ds, dU_prev, done = ds0, None, []
+    U, mu, lam = U_new, mu_new, lam + step
+    done.append(make_increment(eq, U, mu, lam, it, residuals, negative, t0))
+    if on_increment is not None:
+        on_increment(done[-1])
+    ds = ds0
     while lam < path.max_load_factor * (1 - 1e-12):
         if len(done) >= path.max_increments:
             raise PathFollowingError(
@@ -105,21 +146,25 @@ def follow_arc_length(eq, path: PathSettings, on_increment=None, log=None,
             if log is not None:
                 log.warning("arc-length increment from λ = %.5g did not converge; Δs → %.3g",
                             lam, ds)
-            if ds < path.min_step * ds0:
+            if ds < 0.1 * path.min_step * ds0:
                 raise PathFollowingError(
                     f"arc length: the path stopped at λ = {lam:.5g}: the arc could not be cut "
-                    f"below {path.min_step:g} of the initial one and still converge (a "
+                    f"below {0.1 * path.min_step:g} of the initial one and still converge (a "
                     "bifurcation or a very sharp turn). The converged increments are saved. "
                     "Use more increments or a finer point set.")
             continue
         U_new, mu_new, lam_new, it, residuals, negative = result
+        if abs(lam_new - lam) > 1.5 * nominal:
+            # too coarse in λ to resolve the curve (the shell stiffens): shorten the arc
+            ds *= nominal / abs(lam_new - lam)
+            continue
         if lam_new > path.max_load_factor:
             # land on λ_max exactly, from the last converged state
             exact = load_increment(eq, path, U, mu, path.max_load_factor, log)
             if exact is not None:
                 U_new, mu_new, it, residuals, negative = exact
                 lam_new = path.max_load_factor
-        dU_prev = U_new - U
+        dU_prev = arc_mask(eq, U.size) * (U_new - U)
         U, mu, lam = U_new, mu_new, lam_new
         done.append(make_increment(eq, U, mu, lam, it, residuals, negative, t0))
         if on_increment is not None:

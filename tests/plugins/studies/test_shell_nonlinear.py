@@ -31,19 +31,6 @@ def test_open_hemisphere_path_and_resume(tmp_path, run_cli):
     assert resumed["load_factor"].values.tolist() == pytest.approx([0.1, 0.15])
 
 
-def test_first_crossing_reports_what_force_control_sees():
-    import numpy as np
-
-    from pointatlas_studies.shell_nonlinear import first_crossing
-
-    # a path over a limit point at λ = 0.5, down to 0.3, and up again to 1
-    lam = [0.25, 0.5, 0.4, 0.3, 0.6, 1.0]
-    w = [1.0, 2.0, 2.5, 3.0, 4.0, 5.0]
-    got = first_crossing([0.25, 0.45, 0.55, 1.0, 1.2], lam, w)
-    assert got[:4] == pytest.approx([1.0, 1.8, 3.0 + 0.25 / 0.3, 5.0])
-    assert np.isnan(got[4])
-
-
 def test_nonlinear_run_on_a_vtp_point_cloud_needs_no_code(tmp_path, run_cli):
     """The open hemisphere's points as a .vtp file, supports, loads and monitors given only
     on the command line: the same path as the built-in experiment (Sze et al. at 0.1 P_max)."""

@@ -121,7 +121,8 @@ class ShellNonlinearStudy:
                             self.newton_tol, control="arc_length" if self.control ==
                             "arc_length" else "load", lbfgs_iterations=self.lbfgs_iterations,
                             lbfgs_tol=self.lbfgs_tol, line_search=self.line_search,
-                            max_increments=self.max_increments)
+                            max_increments=self.max_increments,
+                            levels=tuple(self.reference_load_factors))
         self._imposed = [(k, np.asarray(sup.value, float)) for k, sup in enumerate(s.supports)
                          if sup.kind == "displacement"]
         self._has_loads = bool(np.any(F))

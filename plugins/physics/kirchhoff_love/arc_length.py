@@ -22,7 +22,9 @@ predictor follows the tangent δU_F with the sign of ΔU_prev·δU_F
 (so the path continues through limit points). Δs adapts to the Newton iterations
 (×sqrt(desired/it), within [½, 2] per increment and at most Δs₀, the length of the first
 increment, which is load controlled; an increment whose |Δλ| exceeds 1.5 nominal steps is
-redone with a proportionally shorter arc); a failed
+redone with a proportionally shorter arc); ``path.levels`` (tabulated load factors) are
+solved exactly, by load control from the last converged state, where the path first reaches
+them (the comparison with a table then needs no interpolation); a failed
 increment (no real root, NaN, too many iterations) halves Δs and retries.
 """
 from __future__ import annotations
@@ -111,7 +113,8 @@ def follow_arc_length(eq, path: PathSettings, on_increment=None, log=None,
     # the first increment is load controlled; its length |ΔU| is the arc length Δs₀ (the
     # linear predictor overestimates the response of a stiffening shell by orders of
     # magnitude, and a sphere of that radius may never meet the path)
-    step = nominal
+    pending = {float(x) for x in path.levels if x > lam}
+    step = min([nominal, *pending])
     while True:
         t0 = time.perf_counter()
         first = load_increment(eq, path, U, mu, lam + step, log)
@@ -129,6 +132,7 @@ def follow_arc_length(eq, path: PathSettings, on_increment=None, log=None,
         raise PathFollowingError("arc length: the load (F, g) produces no displacement; give a "
                                  "load or an imposed displacement.")
     U, mu, lam = U_new, mu_new, lam + step
+    pending = {x for x in pending if x > lam * (1 + 1e-12)}
     done.append(make_increment(eq, U, mu, lam, it, residuals, negative, t0))
     if on_increment is not None:
         on_increment(done[-1])
@@ -164,6 +168,17 @@ def follow_arc_length(eq, path: PathSettings, on_increment=None, log=None,
             if exact is not None:
                 U_new, mu_new, it, residuals, negative = exact
                 lam_new = path.max_load_factor
+        if lam_new > lam:
+            # tabulated levels first reached in (λ, λ_new]: land on them by load control
+            for level in sorted(x for x in pending if lam < x < lam_new):
+                t1 = time.perf_counter()
+                exact = load_increment(eq, path, U, mu, level, log)
+                pending.discard(level)
+                if exact is not None:
+                    done.append(make_increment(eq, exact[0], exact[1], level, *exact[2:], t1))
+                    if on_increment is not None:
+                        on_increment(done[-1])
+            pending.difference_update(x for x in list(pending) if x <= lam_new)
         dU_prev = arc_mask(eq, U.size) * (U_new - U)
         U, mu, lam = U_new, mu_new, lam_new
         done.append(make_increment(eq, U, mu, lam, it, residuals, negative, t0))

@@ -79,6 +79,7 @@ class PathSettings:
     lbfgs_tol: float = 1e-2       # L-BFGS stops at |∇Π_ρ| ≤ lbfgs_tol·|load|
     line_search: bool = False     # Armijo backtracking on Π_ρ while |R| > 1e-3·|load|
     max_increments: int = 400     # arc length: give up after this many increments
+    levels: tuple = ()            # also solve at these λ (where first reached, arc length)
     desired_iterations: int = 5   # arc length: Newton iterations the step size aims at
 
 
@@ -103,8 +104,13 @@ def follow_path(model, settings, path: PathSettings, F: np.ndarray, constraints,
     step = nominal
     prev = None        # (U, step) of the previous increment, for the secant predictor
     done: list[Increment] = []
+    levels = sorted(float(x) for x in path.levels if x > lam_load)
     while lam_load < path.max_load_factor * (1 - 1e-12):
         step = min(step, path.max_load_factor - lam_load)
+        # land on the tabulated levels (the comparison with a table needs no interpolation)
+        ahead = [x for x in levels if lam_load * (1 + 1e-12) < x < lam_load + step]
+        if ahead:
+            step = ahead[0] - lam_load
         target = lam_load + step
         t0 = time.perf_counter()
         # secant predictor: extrapolate the last converged increment to the new load

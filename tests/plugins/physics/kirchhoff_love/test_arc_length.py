@@ -64,6 +64,18 @@ def test_arc_length_passes_the_limit_points_and_reaches_the_load():
     assert lam[-1] == 1.0 and u[-1] > upper and force(u[-1]) == pytest.approx(1.0, abs=1e-9)
 
 
+def test_tabulated_levels_are_solved_exactly_where_first_reached():
+    path = PathSettings(n_increments=10, tol=1e-10, max_newton=15, levels=(0.05, 0.15, 0.5))
+    incs = follow_arc_length(CubicSpring(), path)
+    lam = [i.load_factor for i in incs]
+    assert lam[0] == 0.05 and 0.15 in lam and 0.5 in lam
+    # 0.5 is first reached after the snap-through: on the far stable branch
+    at = {i.load_factor: i.U.ravel()[0] for i in incs}
+    assert force(at[0.15]) == pytest.approx(0.15, abs=1e-9) and at[0.15] < 0.461
+    assert force(at[0.5]) == pytest.approx(0.5, abs=1e-9) and at[0.5] > 1.206
+    assert lam.index(0.5) > lam.index(0.15) + 2
+
+
 def test_force_control_jumps_over_the_unstable_branch(monkeypatch):
     """Minimising at each load, force control snaps from the first stable branch to the far
     one (what a dynamic snap-through does) and never sees the unstable states."""
@@ -77,3 +89,8 @@ def test_force_control_jumps_over_the_unstable_branch(monkeypatch):
     assert all(i.stable for i in incs) and not np.any((u > lower) & (u < upper))
     assert u[1] < lower < upper < u[2]  # λ = 0.2 before the limit point 0.201, 0.3 after
     assert force(u[-1]) == pytest.approx(1.0, abs=1e-9)
+    landed = follow_path(None, None, PathSettings(n_increments=10, tol=1e-10,
+                                                  levels=(0.05, 0.33)), None, None)
+    lam = [round(i.load_factor, 12) for i in landed]
+    assert lam[0] == 0.05 and 0.33 in lam and lam[-1] == 1.0
+    assert max(np.diff([0.0, *lam])) <= 0.1 + 1e-12

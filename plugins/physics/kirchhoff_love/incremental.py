@@ -109,17 +109,15 @@ def follow_path(model, settings, path: PathSettings, F: np.ndarray, constraints,
         step = min(step, path.max_load_factor - lam_load)
         # land on the tabulated levels (the comparison with a table needs no interpolation)
         ahead = [x for x in levels if lam_load * (1 + 1e-12) < x < lam_load + step]
-        if ahead:
-            step = ahead[0] - lam_load
-        target = lam_load + step
+        target = ahead[0] if ahead else lam_load + step
         t0 = time.perf_counter()
         # secant predictor: extrapolate the last converged increment to the new load
-        guess = U if prev is None else U + (step / prev[1]) * (U - prev[0])
+        guess = U if prev is None else U + ((target - lam_load) / prev[1]) * (U - prev[0])
         result = load_increment(eq, path, guess, mu, target, log)
         if result is None and prev is not None:
             result = load_increment(eq, path, U, mu, target, log)
         if result is None:
-            step *= 0.5
+            step = 0.5 * (target - lam_load)
             if log is not None:
                 log.warning("increment to λ = %.5g did not converge; cutting the step to %.3g",
                             target, step)
@@ -131,7 +129,7 @@ def follow_path(model, settings, path: PathSettings, F: np.ndarray, constraints,
                     "smaller steps (more increments), displacement control, or arc-length "
                     "control (study.control=arc_length).")
             continue
-        prev = (U, step)
+        prev = (U, target - lam_load)
         U, mu, it, residuals, negative = result
         lam_load = target
         done.append(make_increment(eq, U, mu, lam_load, it, residuals, negative, t0))

@@ -115,10 +115,12 @@ _BAR = {"title": "energy density", "color": "black", "vertical": False, "fmt": "
 
 
 def _shared_range(values: list[np.ndarray], log_scale: bool) -> tuple[float, float]:
-    """Colour range over all snapshots; for a log scale the floor is max·1e-6 (or the
+    """Colour range over all snapshots, up to the 99.5th percentile (a few outlying point
+    values must not wash out the picture); for a log scale the floor is hi·1e-6 (or the
     smallest positive value if larger)."""
     allv = np.concatenate([v[np.isfinite(v)] for v in values] + [np.zeros(0)])
-    hi = float(allv.max()) if allv.size else 1.0
+    hi = float(np.percentile(allv, 99.5)) if allv.size else 1.0
+    allv = np.minimum(allv, hi)
     if log_scale:
         pos = allv[allv > 0]
         if not pos.size:

@@ -8,6 +8,7 @@ from pointatlas.testing import check_contract, check_plugin
 SMALL = {
     ("source", "file"): None,  # needs a file: built in the test below
     ("source", "connected_pipes"): {"n_points": 400},
+    ("source", "open_pipes"): {"n_points": 600},
     ("embedder", "nlie"): {"n_stress_neighbors": 15, "max_iter": 10, "lbfgs_max_iter": 50},
 }
 LINEAR = {("approximant", "lme")}

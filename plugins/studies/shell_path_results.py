@@ -26,8 +26,8 @@ def first_crossing(levels, lam, values) -> np.ndarray:
     for i, level in enumerate(levels):
         for k in range(len(lam) - 1):
             a, b = lam[k], lam[k + 1]
-            if b > a and a <= level <= b:
-                t = (level - a) / (b - a)
+            if b > a and a - 1e-12 <= level <= b + 1e-12 * max(1.0, abs(b)):
+                t = min(max((level - a) / (b - a), 0.0), 1.0)
                 out[i] = (1 - t) * values[k] + t * values[k + 1]
                 break
     return out

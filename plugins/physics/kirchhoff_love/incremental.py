@@ -110,6 +110,8 @@ def follow_path(model, settings, path: PathSettings, F: np.ndarray, constraints,
         # land on the tabulated levels (the comparison with a table needs no interpolation)
         ahead = [x for x in levels if lam_load * (1 + 1e-12) < x < lam_load + step]
         target = ahead[0] if ahead else lam_load + step
+        if abs(target - path.max_load_factor) <= 1e-9 * abs(path.max_load_factor):
+            target = path.max_load_factor   # end exactly on λ_max (no round-off drift)
         t0 = time.perf_counter()
         # secant predictor: extrapolate the last converged increment to the new load
         guess = U if prev is None else U + ((target - lam_load) / prev[1]) * (U - prev[0])

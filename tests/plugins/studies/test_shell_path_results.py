@@ -45,6 +45,8 @@ def test_first_crossing_reports_what_force_control_sees():
     got = first_crossing([0.25, 0.45, 0.55, 1.0, 1.2], lam, w)
     assert got[:4] == pytest.approx([1.0, 1.8, 3.0 + 0.25 / 0.3, 5.0])
     assert np.isnan(got[4])
+    # a level equal to the last load factor up to round-off is reached
+    assert first_crossing([1.0], [0.3, 0.6, 0.9 + 0.1 - 1e-15], [1, 2, 3])[0] == pytest.approx(3)
 
 
 def test_figures_mark_unstable_increments_and_draw_snapshots():

@@ -37,6 +37,7 @@ from typing import ClassVar, Optional
 
 import numpy as np
 
+from .level_set import near_level_set, project_to_level_set
 from .surface_source import COMMON_CONSTRAINTS, SurfaceSource, require, require_positive
 
 #: Candidates per output point for the structured (farthest-point) selection.
@@ -74,31 +75,17 @@ def pipes_bounds(m: float, w: float, zeta: float) -> np.ndarray:
 
 def project_to_surface(X, m, w, zeta, tol: float = 1e-14, max_iter: int = 60):
     """Newton steps along the gradient, x ← x − F ∇F / |∇F|², until |F| ≤ tol."""
-    X = X.copy()
-    for _ in range(max_iter):
-        F = pipes_function(X, m, w, zeta)
-        if np.max(np.abs(F), initial=0.0) <= tol:
-            break
-        G = pipes_gradient(X, m, w, zeta)
-        X -= (F / np.einsum("ij,ij->i", G, G))[:, None] * G
-    return X
+    return project_to_level_set(X, _value_gradient(m, w, zeta), tol, max_iter)
+
+
+def _value_gradient(m, w, zeta):
+    return lambda X: (pipes_function(X, m, w, zeta), pipes_gradient(X, m, w, zeta))
 
 
 def thin_shell_candidates(draw, n: int, params, half_width: float):
-    """Keep box samples from ``draw(k)`` within |F|/|∇F| < half_width of the surface.
-
-    Uniform samples in a symmetric shell project to a density uniform w.r.t. area up to
-    O(half_width²·curvature²) (the linear term 2H·distance of the volume element cancels).
-    """
-    out, have = [], 0
-    while have < n:
-        C = draw(max(4096, 30 * (n - have)))
-        G = pipes_gradient(C, *params)
-        dist = np.abs(pipes_function(C, *params)) / np.sqrt(np.einsum("ij,ij->i", G, G))
-        keep = C[dist < half_width]
-        out.append(keep)
-        have += keep.shape[0]
-    return np.concatenate(out)[:n]
+    """Keep box samples from ``draw(k)`` within |F|/|∇F| < half_width of the surface
+    (:func:`.level_set.near_level_set`)."""
+    return near_level_set(draw, n, _value_gradient(*params), half_width, 4096, 30)
 
 
 def _graph_area_integral(phi: np.ndarray, m: float, w: float, zeta: float, n_nodes: int):

@@ -42,6 +42,7 @@ from pointatlas.pointcloud import PointCloud, check_distinct
 from pointatlas.stores_config import stores_config
 
 from .farthest_point import farthest_point_order
+from .level_set import near_level_set, project_to_level_set
 from .shell_source import JITTER, SHELL_CONSTRAINTS
 from .surface_source import SurfaceSource, check_rng, require, require_positive
 
@@ -96,27 +97,16 @@ def pipes_value_gradient(X: np.ndarray, r: float, a: float, b: float, k: float):
 def project_to_surface(X, r, a, b, k, tol: float = 1e-13, max_iter: int = 50):
     """Newton steps x ← x − F ∇F/|∇F|² until |F| ≤ tol·r (along ∇F, which is horizontal
     on the plain cylinders at the ends, so z is kept there)."""
-    X = np.array(X, dtype=np.float64)
-    for _ in range(max_iter):
-        F, G = pipes_value_gradient(X, r, a, b, k)
-        if np.max(np.abs(F), initial=0.0) <= tol * r:
-            break
-        X -= (F / np.einsum("ij,ij->i", G, G))[:, None] * G
-    return X
+    return project_to_level_set(X, lambda Y: pipes_value_gradient(Y, r, a, b, k), tol * r,
+                                max_iter)
 
 
 def shell_candidates(draw, n: int, r, a, b, k, H: float, half_width: float):
     """Box samples from ``draw(m)`` within |F|/|∇F| < half_width of the surface and
-    |z| ≤ H, projected onto F = 0 (n rows). The symmetric shell projects to a density
-    uniform in area up to O(half_width²·curvature²)."""
-    out, have = [], 0
-    while have < n:
-        C = draw(max(8192, 40 * (n - have)))
-        F, G = pipes_value_gradient(C, r, a, b, k)
-        keep = C[(np.abs(F) < half_width * np.linalg.norm(G, axis=1)) & (np.abs(C[:, 2]) <= H)]
-        out.append(keep)
-        have += len(keep)
-    return project_to_surface(np.concatenate(out)[:n], r, a, b, k)
+    |z| ≤ H, projected onto F = 0 (n rows; :mod:`.level_set`)."""
+    C = near_level_set(draw, n, lambda Y: pipes_value_gradient(Y, r, a, b, k), half_width,
+                       8192, 40, accept=lambda Y: np.abs(Y[:, 2]) <= H)
+    return project_to_surface(C, r, a, b, k)
 
 
 # -- area --------------------------------------------------------------------------------

@@ -116,7 +116,7 @@ class ShellNonlinearStudy:
         values = [probe(r.U) for r in records]
         self._fields = [fields(r.U) for r in records]
         self._points = model.points
-        F = self._control_loads(F, s)
+        self._check_control(F, s)
         path = PathSettings(self.n_increments, self.max_load_factor, self.max_newton,
                             self.newton_tol, control="arc_length" if self.control ==
                             "arc_length" else "load", lbfgs_iterations=self.lbfgs_iterations,
@@ -149,8 +149,8 @@ class ShellNonlinearStudy:
         ds.attrs["stopped"] = stopped or "completed the load path"
         return ds
 
-    def _control_loads(self, F, s):
-        """The load vector the control uses; checks that the control has something to do."""
+    def _check_control(self, F, s) -> None:
+        """The control is known and has something to apply (loads or imposed values)."""
         from pointatlas.errors import ConfigError
 
         controls = ("force", "displacement", "arc_length")
@@ -169,7 +169,6 @@ class ShellNonlinearStudy:
         elif not np.any(F) and not imposed:
             raise ConfigError(f"study.control={self.control} but there is nothing to apply: "
                               "give physics.loads or a 'displacement' support.")
-        return F
 
     def _load(self, lam, reactions):
         """(load, long_name): λ·full_load under loads; otherwise the reaction of the

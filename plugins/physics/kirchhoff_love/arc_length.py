@@ -49,11 +49,12 @@ def arc_mask(eq, n_dofs: int) -> np.ndarray:
     return m
 
 
-def arc_increment(eq, path: PathSettings, U0, mu0, lam0: float, ds: float, dU_prev, log=None):
+def arc_increment(eq, path: PathSettings, U0, mu0, lam0: float, ds: float, dU_prev, m,
+                  log=None):
     """One arc-length increment of length ds from the converged (U0, μ0, λ0).
 
-    Returns (U, μ, λ, iterations, residuals, negative pivots) or None if it failed."""
-    m = arc_mask(eq, U0.size)
+    ``m`` is the :func:`arc_mask`. Returns (U, μ, λ, iterations, residuals, negative
+    pivots) or None if it failed."""
     sys = eq.system(U0)
     dUF, dmuF, _ = sys.solve(eq.F, eq.g)
     nF = float(np.linalg.norm(m * dUF))
@@ -144,7 +145,7 @@ def follow_arc_length(eq, path: PathSettings, on_increment=None, log=None,
                 f"λ_max = {path.max_load_factor:g}. The converged increments are saved. "
                 "Raise study.max_increments or use larger steps (fewer study.n_increments).")
         t0 = time.perf_counter()
-        result = arc_increment(eq, path, U, mu, lam, ds, dU_prev, log)
+        result = arc_increment(eq, path, U, mu, lam, ds, dU_prev, mask, log)
         if result is None:
             ds *= 0.5
             if log is not None:
@@ -179,7 +180,7 @@ def follow_arc_length(eq, path: PathSettings, on_increment=None, log=None,
                     if on_increment is not None:
                         on_increment(done[-1])
             pending.difference_update(x for x in list(pending) if x <= lam_new)
-        dU_prev = arc_mask(eq, U.size) * (U_new - U)
+        dU_prev = mask * (U_new - U)
         U, mu, lam = U_new, mu_new, lam_new
         done.append(make_increment(eq, U, mu, lam, it, residuals, negative, t0))
         if on_increment is not None:

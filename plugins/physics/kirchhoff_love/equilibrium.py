@@ -95,10 +95,11 @@ class Equilibrium:
             return self.merit(W, x, mu, lam), grad
 
         scale = self.scale(lam, mu)
+        start = fun(U)[0]
         res = minimize(fun, U, jac=True, method="L-BFGS-B",
                        options={"maxiter": max_iter, "gtol": rel_tol * scale / np.sqrt(U.size),
                                 "maxcor": 20})
-        if not np.all(np.isfinite(res.x)) or not res.fun <= fun(U)[0]:
+        if not np.all(np.isfinite(res.x)) or not res.fun <= start:
             return U, int(res.nit)
         if log is not None:
             log.info("  λ = %.5g  L-BFGS: %d iterations, |∇Π| = %.3e", lam, res.nit,

@@ -7,7 +7,9 @@ load path (:mod:`pointatlas_physics.kirchhoff_love.incremental`) under ``control
 - ``displacement``: the ``displacement`` supports' imposed values grow with λ, there are no
   loads, and ``load`` is the reaction of those supports along their imposed direction;
 - ``arc_length``: Crisfield's arc length (:mod:`pointatlas_physics.kirchhoff_love.arc_length`)
-  on loads and imposed displacements together, through limit points and snap-backs;
+  on loads and imposed displacements together, through limit points and snap-backs; with
+  ``branch_switching`` it also leaves the path at simple bifurcations for the secondary
+  branch (eigenvector injection, :mod:`pointatlas_physics.kirchhoff_love.branch_switching`);
 
 and records, along a dim ``increment``: ``load_factor``, ``load`` (= load_factor × ``full_load``
 under loads),
@@ -44,6 +46,8 @@ class ShellPathSettings(ShellStudySettings):
     lbfgs_tol: float = 1.0e-2           # ... until |∇Π| ≤ lbfgs_tol·|load|
     line_search: bool = False           # Armijo backtracking in Newton (see incremental)
     max_increments: int = 400           # arc length: increments before giving up
+    branch_switching: bool = False      # arc length: leave the path at simple bifurcations
+    max_branch_switches: int = 3        # ... at most this many times
     monitor_points: List[float] = field(default_factory=list)       # x, y, z per point
     monitor_directions: List[float] = field(default_factory=list)   # unit vector per point
     monitor_names: List[str] = field(default_factory=list)
@@ -122,6 +126,8 @@ class ShellNonlinearStudy:
                             "arc_length" else "load", lbfgs_iterations=self.lbfgs_iterations,
                             lbfgs_tol=self.lbfgs_tol, line_search=self.line_search,
                             max_increments=self.max_increments,
+                            branch_switching=self.branch_switching,
+                            max_branch_switches=self.max_branch_switches,
                             levels=tuple(self.reference_load_factors))
         self._imposed = [(k, np.asarray(sup.value, float)) for k, sup in enumerate(s.supports)
                          if sup.kind == "displacement"]
@@ -157,6 +163,9 @@ class ShellNonlinearStudy:
         if self.control not in controls:
             raise ConfigError(f"study.control = {self.control!r} is unknown; use one of "
                               f"{controls}.")
+        if self.branch_switching and self.control != "arc_length":
+            raise ConfigError("study.branch_switching=true needs study.control=arc_length (the "
+                              "secondary branch is followed by arc length).")
         imposed = any(sup.kind == "displacement" for sup in s.supports)
         if self.control == "displacement":
             if not imposed:

@@ -56,6 +56,10 @@ def path_dataset(study, dof: int, points, records, values, names, fields, loads)
         "newton_iterations": (("increment",), its, {**ONE, "long_name": "Newton iterations"}),
         "stable": (("increment",), np.array([r.stable for r in records], np.int8), {
             **ONE, "long_name": "1 if no negative pivot of the constrained tangent"}),
+        "negative_pivots": (("increment",), np.array([r.negative_pivots for r in records],
+                                                     np.int32), {
+            **ONE, "long_name": "negative pivots of the factorised constrained tangent "
+                                "(-1: not computed)"}),
         "increment_time": (("increment",), secs, {"long_name": "wall time of the increment",
                                                   "units": "s"}),
         "time_per_newton_iteration": ((), float(secs.sum() / its.sum()) if its.sum() else

@@ -50,20 +50,25 @@ def arc_mask(eq, n_dofs: int) -> np.ndarray:
 
 
 def arc_increment(eq, path: PathSettings, U0, mu0, lam0: float, ds: float, dU_prev, m,
-                  log=None):
+                  log=None, predictor: Optional[np.ndarray] = None):
     """One arc-length increment of length ds from the converged (U0, μ0, λ0).
 
-    ``m`` is the :func:`arc_mask`. Returns (U, μ, λ, iterations, residuals, negative
-    pivots) or None if it failed."""
-    sys = eq.system(U0)
-    dUF, dmuF, _ = sys.solve(eq.F, eq.g)
-    nF = float(np.linalg.norm(m * dUF))
-    if not (np.isfinite(nF) and nF > 0):
-        return None
-    sign = 1.0 if dU_prev is None or float(dU_prev @ (m * dUF)) >= 0 else -1.0
-    dlam = sign * ds / nF
-    DU, Dmu, lam = dlam * dUF, dlam * dmuF, lam0 + dlam
-    residuals, negative = [], sys.negative_pivots
+    ``m`` is the :func:`arc_mask`. The predictor is the tangent δU_F (scaled to Δs), or
+    ``predictor`` (a direction of unit masked length, with Δλ = 0: the eigenvector
+    injection of :mod:`.branch_switching`). Returns (U, μ, λ, iterations, residuals,
+    negative pivots) or None if it failed."""
+    if predictor is None:
+        sys = eq.system(U0)
+        dUF, dmuF, _ = sys.solve(eq.F, eq.g)
+        nF = float(np.linalg.norm(m * dUF))
+        if not (np.isfinite(nF) and nF > 0):
+            return None
+        sign = 1.0 if dU_prev is None or float(dU_prev @ (m * dUF)) >= 0 else -1.0
+        dlam = sign * ds / nF
+        DU, Dmu, lam = dlam * dUF, dlam * dmuF, lam0 + dlam
+    else:
+        DU, Dmu, lam = ds * predictor, np.zeros_like(mu0), lam0
+    residuals, negative = [], -1
     R, _ = eq.residual(U0 + DU, mu0 + Dmu, lam)
     for it in range(1, path.max_newton + 1):
         U = U0 + DU
@@ -137,7 +142,7 @@ def follow_arc_length(eq, path: PathSettings, on_increment=None, log=None,
     done.append(make_increment(eq, U, mu, lam, it, residuals, negative, t0))
     if on_increment is not None:
         on_increment(done[-1])
-    ds = ds0
+    ds, switches = ds0, 0
     while lam < path.max_load_factor * (1 - 1e-12):
         if len(done) >= path.max_increments:
             raise PathFollowingError(
@@ -163,8 +168,9 @@ def follow_arc_length(eq, path: PathSettings, on_increment=None, log=None,
             # too coarse in λ to resolve the curve (the shell stiffens): shorten the arc
             ds *= nominal / abs(lam_new - lam)
             continue
-        if lam_new > path.max_load_factor:
-            # land on λ_max exactly, from the last converged state
+        if lam_new > path.max_load_factor * (1 - 1e-12) and lam_new != path.max_load_factor:
+            # land on λ_max exactly (also when within round-off of it), from the last
+            # converged state
             exact = load_increment(eq, path, U, mu, path.max_load_factor, log)
             if exact is not None:
                 U_new, mu_new, it, residuals, negative = exact
@@ -181,10 +187,56 @@ def follow_arc_length(eq, path: PathSettings, on_increment=None, log=None,
                         on_increment(done[-1])
             pending.difference_update(x for x in list(pending) if x <= lam_new)
         dU_prev = mask * (U_new - U)
+        rising = lam_new > lam and (len(done) < 2 or
+                                    done[-1].load_factor > done[-2].load_factor)
         U, mu, lam = U_new, mu_new, lam_new
         done.append(make_increment(eq, U, mu, lam, it, residuals, negative, t0))
         if on_increment is not None:
             on_increment(done[-1])
+        if (path.branch_switching and switches < path.max_branch_switches and rising
+                and len(done) >= 2 and negative > done[-2].negative_pivots >= 0):
+            t0 = time.perf_counter()
+            switched = switch_branch(eq, path, U, mu, lam, ds, dU_prev, mask, log)
+            if switched is not None:
+                switches += 1
+                U_new, mu_new, lam_new, it, residuals, negative = switched
+                dU_prev = mask * (U_new - U)
+                U, mu, lam = U_new, mu_new, lam_new
+                pending.difference_update(x for x in list(pending) if x <= lam)
+                done.append(make_increment(eq, U, mu, lam, it, residuals, negative, t0))
+                if on_increment is not None:
+                    on_increment(done[-1])
         ds = min(ds * float(np.clip(np.sqrt(path.desired_iterations / max(it, 1)), 0.5, 2.0)),
                  ds0)
     return done
+
+
+def switch_branch(eq, path: PathSettings, U, mu, lam: float, ds: float, step, mask, log=None):
+    """Leave the primary path at a simple bifurcation just crossed by ``step`` (the last
+    increment, which reached (U, μ, λ) with more negative pivots than before): an arc-length
+    increment whose predictor is the critical eigenvector (:mod:`.branch_switching`), of
+    length Δs and then 2Δs. Accepted if it converges to a state with fewer negative pivots
+    (the secondary branch); otherwise None and the path goes on along the primary branch."""
+    from .branch_switching import bifurcation_mode
+
+    system = eq.system(U)
+    count = system.negative_pivots
+    phi = bifurcation_mode(system, step, mask)
+    if phi is None:
+        if log is not None:
+            log.info("λ = %.5g: %d negative pivots, the unstable mode is along the path (a "
+                     "limit point): no branch switch", lam, count)
+        return None
+    for length in (ds, 2.0 * ds):
+        result = arc_increment(eq, path, U, mu, lam, length, None, mask, log, predictor=phi)
+        if result is not None and 0 <= result[5] < count:
+            if log is not None:
+                log.info("λ = %.5g: bifurcation (%d negative pivots); switched to the "
+                         "secondary branch at λ = %.5g (%d negative pivots)", lam, count,
+                         result[2], result[5])
+            return result
+    if log is not None:
+        log.warning("λ = %.5g: bifurcation (%d negative pivots) but the eigenvector predictor "
+                    "did not reach a more stable branch; going on along the primary path",
+                    lam, count)
+    return None

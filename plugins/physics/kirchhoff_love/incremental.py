@@ -81,6 +81,8 @@ class PathSettings:
     max_increments: int = 400     # arc length: give up after this many increments
     levels: tuple = ()            # also solve at these λ (where first reached, arc length)
     desired_iterations: int = 5   # arc length: Newton iterations the step size aims at
+    branch_switching: bool = False  # arc length: leave the path at simple bifurcations
+    max_branch_switches: int = 3
 
 
 def follow_path(model, settings, path: PathSettings, F: np.ndarray, constraints,

@@ -81,9 +81,14 @@ class ConstrainedSystem:
         CtC = (C.T @ C).tocsr()
         scale_c = CtC.diagonal().mean() if C.shape[0] else 0.0
         self.rho = penalty * K.diagonal().mean() / scale_c if scale_c > 0 else 0.0
-        self._solve = factorize((K + self.rho * CtC).tocsr(), method)
+        self.matrix = (K + self.rho * CtC).tocsr()     # K_ρ, for eigen-analysis
+        self._solve = factorize(self.matrix, method)
         self.negative_pivots = getattr(self._solve, "negative_pivots", -1)
         self.factorize_time = time.perf_counter() - t0
+
+    def inverse(self, b: np.ndarray) -> np.ndarray:
+        """K_ρ⁻¹ b with the factorisation (no constraint iteration)."""
+        return self._solve(np.asarray(b, dtype=float).ravel())
 
     def solve(self, F: np.ndarray, g: np.ndarray):
         """(U, λ, SolveInfo) for min ½UᵀKU − FᵀU subject to CU = g."""

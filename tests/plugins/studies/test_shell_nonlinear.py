@@ -62,3 +62,18 @@ def test_nonlinear_run_on_a_vtp_point_cloud_needs_no_code(tmp_path, run_cli):
     assert a == pytest.approx(1.499, rel=0.15) and b == pytest.approx(1.840, rel=0.15)
     assert ds["energy_density"].dims == ("increment", "sample")
     assert float(ds["energy_density"].min()) >= 0 and float(ds["energy_density"].max()) > 0
+
+
+def test_branch_switching_needs_arc_length():
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from pointatlas.errors import ConfigError
+    from pointatlas_studies.shell_nonlinear import ShellNonlinearStudy
+
+    s = SimpleNamespace(supports=[SimpleNamespace(kind="clamped")])
+    study = ShellNonlinearStudy(control="force", branch_switching=True)
+    with pytest.raises(ConfigError, match="branch_switching=true needs study.control=arc_length"):
+        study._check_control(np.ones(3), s)
+    ShellNonlinearStudy(control="arc_length", branch_switching=True)._check_control(np.ones(3), s)

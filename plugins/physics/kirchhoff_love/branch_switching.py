@@ -1,0 +1,76 @@
+"""Branch switching at simple bifurcation points of a shell's equilibrium path.
+
+A symmetric structure loaded along a path of symmetric states (the connected pipes under an
+imposed displacement, thesis L2557, Paper 2 §5.6) reaches bifurcation points where the
+constrained tangent K_T + ρCᵀC loses positive definiteness while λ keeps increasing: the
+primary path goes on, but unstable, and an arc-length method follows it. At a simple
+bifurcation the critical eigenvector φ (K_T φ = 0 on the constraint space) is orthogonal to
+the load, φᵀF = 0, so the path tangent has no component along it; at a limit point the
+tangent *is* φ (Riks 1984, "Bifurcation and stability, a numerical approach", in Innovative
+Methods for Nonlinear Problems; Wriggers & Simo 1990, Commun. Appl. Numer. Methods 6:303).
+Hence the test used here: an increment whose count of negative pivots grew while λ kept
+growing, and whose step ΔU is nearly orthogonal to the new unstable mode, has crossed a
+bifurcation.
+
+The switch is the eigenvector injection of Wagner & Wriggers (1988, "A simple method for
+the calculation of postcritical branches", Eng. Comput. 5:103–109): the next arc-length
+increment starts from the predictor ΔU = Δs φ/|φ| (Δλ = 0) instead of the path tangent;
+the corrector on the cylinder |ΔU| = Δs then converges to the secondary branch, which
+crosses that cylinder near the predictor, and the continuation goes on along it.
+"""
+from __future__ import annotations
+
+from typing import Optional
+
+import numpy as np
+
+
+def negative_modes(system, count: int, extra: int = 4, tol: float = 1e-8):
+    """(eigenvalues, vectors) of the factorised K_T + ρCᵀC (:class:`.solver.ConstrainedSystem`)
+    that are negative, most negative first, by shift-invert Lanczos around 0 (scipy
+    ``eigsh``) reusing the factorisation: one back-substitution per Lanczos step.
+
+    ``count`` is the number of negative pivots; ``extra`` more eigenpairs nearest 0 are
+    computed because weakly held (ghost) DOFs add small positive eigenvalues near 0.
+    Units: eigenvalues in force per length (stiffness)."""
+    from scipy.sparse.linalg import LinearOperator, eigsh
+
+    A = system.matrix
+    n = A.shape[0]
+    k = int(min(max(count, 1) + extra, n - 2))
+    if k < 1:
+        return np.zeros(0), np.zeros((n, 0))
+    inverse = LinearOperator(A.shape, matvec=system.inverse, dtype=float)
+    vals, vecs = eigsh(A, k=k, sigma=0.0, which="LM", OPinv=inverse, tol=tol)
+    order = np.argsort(vals)
+    vals, vecs = vals[order], vecs[:, order]
+    keep = vals < 0
+    return vals[keep], vecs[:, keep]
+
+
+def bifurcation_mode(system, step: np.ndarray, mask: np.ndarray,
+                     max_cosine: float = 0.5) -> Optional[np.ndarray]:
+    """The most unstable eigenvector of ``system`` if the state is past a simple bifurcation
+    crossed by ``step`` (the last increment's ΔU), else None.
+
+    It is a bifurcation when |cos(φ, ΔU)| in the masked metric (control points of the
+    surface, :func:`.arc_length.arc_mask`) is below ``max_cosine``: the path did not turn
+    along φ as it does at a limit point. φ is normalised to unit masked length with its
+    largest entry positive (a reproducible choice of the two symmetric branches)."""
+    count = getattr(system, "negative_pivots", -1)
+    if count <= 0:
+        return None
+    vals, vecs = negative_modes(system, count)
+    if vals.size == 0:
+        return None
+    phi = vecs[:, 0]
+    if mode_cosine(phi, step, mask) >= max_cosine:
+        return None
+    phi = phi / float(np.sqrt(phi @ (mask * phi)))
+    return phi if phi[np.argmax(np.abs(phi))] > 0 else -phi
+
+
+def mode_cosine(phi: np.ndarray, step: np.ndarray, mask: np.ndarray) -> float:
+    """|cos(φ, ΔU)| in the masked metric (dimensionless)."""
+    a = float(np.sqrt(phi @ (mask * phi)) * np.sqrt(step @ (mask * step)))
+    return abs(float(phi @ (mask * step))) / a if a > 0 else 0.0

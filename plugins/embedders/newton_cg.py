@@ -1,9 +1,11 @@
 """Line-search Newton with a preconditioned, truncated conjugate-gradient inner solve.
 
-Used by NLIE (thesis Appendix C: "Newton's method with a line search"). The Hessian may be
-singular (rigid motions of the embedding) and indefinite away from a minimum: CG stops at
-negative curvature (Steihaug), and a small shift ``shift * mean(diag H)`` regularises the null
-space.
+Used by NLIE (thesis Appendix C: "Newton's method with a line search"). Away from a minimum the
+Hessian may be indefinite: CG stops at negative curvature (Steihaug) and the step is recomputed
+with a positive semidefinite ("convex") approximation of the Hessian supplied by the caller, a
+Gauss-Newton-like modification that always gives a descent direction. Near the minimum the true
+Hessian is used, and the inexact Newton steps converge superlinearly (forcing term
+eta_k = min(0.1, sqrt(|g_k| / |g_0|)), Eisenstat-Walker).
 """
 from __future__ import annotations
 
@@ -21,6 +23,8 @@ class NewtonResult:
     n_iter: int
     cg_iters: int
     converged: bool
+    n_convex: int = 0
+    grad: np.ndarray | None = None
 
 
 def truncated_pcg(matvec: Callable, b: np.ndarray, precond: Callable, rtol: float,
@@ -52,38 +56,35 @@ def truncated_pcg(matvec: Callable, b: np.ndarray, precond: Callable, rtol: floa
 
 
 def newton_line_search(fun_grad: Callable, fun: Callable, hess: Callable, x0: np.ndarray, *,
-                       grad_tol: float, max_iter: int = 50, max_cg: int = 500,
-                       shift: float = 1e-10) -> NewtonResult:
+                       converged: Callable, max_iter: int = 50, max_cg: int = 500,
+                       f0=None) -> NewtonResult:
     """Minimise ``fun`` from ``x0``.
 
-    ``fun_grad(x) -> (f, g)``, ``fun(x) -> f``, ``hess(x) -> (matvec, precond, scale)`` where
-    ``precond`` applies an approximation of H^{-1} and ``scale`` is a typical diagonal entry.
-    Stops when max|g| <= ``grad_tol``. Where CG meets negative curvature early, the step is
-    recomputed with H + mu scale I (Levenberg shift, mu raised x10, lowered after full steps).
-    Armijo backtracking from the full step.
+    ``fun_grad(x) -> (f, g)``; ``fun(x) -> f``; ``hess(x, convex) -> (matvec, precond)`` with
+    ``convex=False`` the Hessian at x and ``convex=True`` a positive semidefinite approximation,
+    ``precond`` applying an approximation of its inverse; ``converged(g) -> bool`` the stopping
+    test. ``f0``: optional (f, g) at x0. Armijo backtracking from the full step.
     """
     x = x0.copy()
-    f, g = fun_grad(x)
-    g0 = np.linalg.norm(g)
+    f, g = f0 if f0 is not None else fun_grad(x)
+    g0 = max(np.linalg.norm(g), 1e-300)
     cg_total = 0
-    converged = bool(np.abs(g).max() <= grad_tol)
+    n_convex = 0
+    done = bool(converged(g))
     it = 0
-    mu = 0.0                                 # adaptive Levenberg shift (units of mean diag H)
-    while not converged and it < max_iter:
+    while not done and it < max_iter:
         it += 1
-        matvec, precond, scale = hess(x)
-        gn = np.linalg.norm(g)
-        eta = min(0.1, np.sqrt(gn / max(g0, 1e-300)))
-        for _ in range(8):                   # raise the shift until CG sees positive curvature
-            shift_abs = (mu + shift) * scale
-            step, ncg, neg = truncated_pcg(lambda v: matvec(v) + shift_abs * v, -g, precond,
-                                           eta, max_cg)
+        eta = min(0.1, np.sqrt(np.linalg.norm(g) / g0))
+        matvec, precond = hess(x, False)
+        step, ncg, neg = truncated_pcg(matvec, -g, precond, eta, max_cg)
+        cg_total += ncg
+        if neg:                              # indefinite: Newton step on the convex part
+            n_convex += 1
+            matvec, precond = hess(x, True)
+            step, ncg, neg = truncated_pcg(matvec, -g, precond, eta, max_cg)
             cg_total += ncg
-            if not neg or ncg > 5:
-                break
-            mu = max(10.0 * mu, 1e-3)
         slope = g @ step
-        if slope >= 0:                      # not a descent direction: preconditioned gradient
+        if slope >= 0:                       # not a descent direction: preconditioned gradient
             step = -precond(g)
             slope = g @ step
         alpha = 1.0
@@ -94,10 +95,7 @@ def newton_line_search(fun_grad: Callable, fun: Callable, hess: Callable, x0: np
             alpha *= 0.5
         else:
             break                            # no decrease: stationary to machine precision
-        mu = mu * 0.1 if alpha == 1.0 else max(mu, 1e-4) * (1.0 if alpha > 0.2 else 10.0)
-        if mu < 1e-8:
-            mu = 0.0
         x = x + alpha * step
         f, g = fun_grad(x)
-        converged = bool(np.abs(g).max() <= grad_tol)
-    return NewtonResult(x, float(f), float(np.abs(g).max()), it, cg_total, converged)
+        done = bool(converged(g))
+    return NewtonResult(x, float(f), float(np.abs(g).max()), it, cg_total, done, n_convex, g)

@@ -36,3 +36,22 @@ def test_nlie_errors():
     two = np.r_[X, X + 10]
     with pytest.raises(InputError, match="2 connected components"):
         NLIE(n_neighbors=5, n_stress_neighbors=10).fit(two)
+
+
+def test_nlie_optimize_newton_from_distorted_seed_and_lbfgs_stage():
+    from pointatlas_embedders.geodesics import geodesic_neighbors, pairs_from_neighbors
+    from pointatlas_embedders.neighbor_graph import neighbor_graph
+    from pointatlas_embedders.nlie import gradient_tolerance, nlie_optimize
+
+    rng = np.random.default_rng(2)
+    P = rng.random((300, 2)) * [3, 1]
+    G = neighbor_graph(np.c_[P, 0.3 * P[:, 0]], 10)
+    pi, pj, g, w = pairs_from_neighbors(*geodesic_neighbors(G, 30))
+    Y0 = P * [1.1, 0.9] + 0.02 * rng.normal(size=P.shape)     # locally distorted, globally right
+    for lbfgs in (0, 10):
+        Y, info = nlie_optimize(Y0, pi, pj, g, w, 0.99, tol=1e-8, lbfgs_max_iter=lbfgs)
+        assert info["converged"] and info["lbfgs_iter"] <= lbfgs
+        assert info["grad_max"] <= gradient_tolerance(g, w, 300, 1e-8) == info["grad_tol"]
+        assert info["newton_iter"] <= 40
+    # the tilted plane is developable but graph paths are longer than straight lines: E > 0, small
+    assert 0 < info["objective"] < 1e-2 * pi.size

@@ -1,16 +1,24 @@
 """Affine isometric correction (AIC), thesis Appendix E.1 (and §3, Table 1).
 
 Given an embedding Y = {y_a} (N, d) from any NLDR method, find the symmetric positive-definite
-d x d matrix A minimising the stress
+d x d matrix A minimising the stress (thesis L3567-3570, L3655; the reading of the printed
+formula is argued in ``quality``)
 
     E_S(A) = 1/2 sum_a sum_{b in N(a)} ((|A (y_a - y_b)| - g_ab) / g_ab)^2,
 
-with N(a) the k nearest neighbours of x_a and g_ab their geodesic (graph) distance. By the polar
-decomposition, a general T with det T > 0 gives nothing more than its SPD factor. A is
-parametrised by its d(d+1)/2 upper-triangular entries t; Newton's method with an Armijo
-backtracking line search that rejects steps leaving the SPD cone. The Hessian is modified (its
-eigenvalues are taken in absolute value and floored) where it is not positive definite.
-Start: A0 = s I with the best uniform scale s (the thesis starts at A0 = I).
+with N(a) the k nearest neighbours of x_a and g_ab their geodesic (graph) distance (= |x_a - x_b|
+for a k-NN edge). The thesis minimises over d x d matrices T with det T > 0 and notes that by
+the polar decomposition the SPD factor suffices (L3571): |R U v| = |U v|. A is parametrised by
+its d(d+1)/2 upper-triangular entries t; Newton's method with an Armijo backtracking line search
+that rejects steps leaving the SPD cone (thesis: L-BFGS, then Newton with line search, L3665;
+"converges very rapidly", L2095). The Hessian is modified (its eigenvalues are taken in
+absolute value and floored) where it is not positive definite.
+Start: A0 = s I with the best uniform scale s = sum(r/g) / sum((r/g)^2), the exact minimiser of
+E_S over A = s I (the thesis starts at T0 = I, L3665). This matters for LLE/MLLE, whose
+unit-covariance output (thesis L1873) has an arbitrary scale: the optimum is then far from I
+(A ~ 0.4 I on the unit quarter sphere, ~4 I on a sphere of radius 10). The result is invariant
+under Y -> Y B for any invertible B and equals the minimum over all 2 x 2 T found by a
+derivative-free search (checked in the tests), so the reported optimum is the global one.
 """
 from __future__ import annotations
 

@@ -82,7 +82,7 @@ def main(argv=None):
     ap.add_argument("--nodes", type=int, default=20_000)
     ap.add_argument("--points", type=int, default=100_000)
     ap.add_argument("--baseline-points", type=int, default=300)
-    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--repeat", type=int, default=5)
     args = ap.parse_args(argv)
 
     import xarray as xr

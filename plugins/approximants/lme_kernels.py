@@ -27,7 +27,6 @@ import numpy as np
 
 from .small_math import FAST as _FAST
 from .small_math import cholesky, cholesky_solve, exp_nonpositive
-from .lme_hessian_2d import hessians_2d
 from .lme_last_step import SMALL_EXPONENT_STEP, small_step_converges
 
 #: initial largest change of any exponent f_a in one Newton step (the cap then adapts)
@@ -255,9 +254,6 @@ def derivatives(yT, beta, p, k, order, lo, grads, hess, gT, jT, hT, mats, vecs, 
             grads[lo + a, i] = p[a] * gi[a]
     if order < 2:
         return True
-    if d == 2:
-        hessians_2d(yT, beta, p, gT, Jinv, bbar, k, lo, hess)
-        return True
     G = mats[1]  # J_β no longer needed (row views below keep the inner loops vectorisable)
     for i in range(d):
         gi = gT[i]
@@ -321,7 +317,8 @@ def lme_kernel(points, visit, cell, starts, entries, entry_x, entry_r2, entry_be
     entry (``beta[entries]``, contiguous like ``entry_r2``); ``indptr`` comes from
     :meth:`support.Cells.count`; the kernel fills ``indices`` (support nodes), ``values``,
     ``grads`` ((nnz, d), if order ≥ 1) and ``hess`` ((nnz, d, d), if order 2).
-    ``status[i]`` receives OK, NO_SUPPORT or NOT_CONVERGED. Points are processed in the order
+    ``status[i]`` receives OK, NO_SUPPORT or NOT_CONVERGED. (d = 2 has its own, faster kernel:
+    :func:`.lme_kernel_2d.lme_kernel_2d`.) Points are processed in the order
     ``visit`` (nearby points together), in chunks that share scratch memory.
     """
     m, d = points.shape

@@ -52,18 +52,29 @@ _LN2_HI = 0.693147180369123816490
 _LN2_LO = 1.90821492927058770002e-10
 
 
-@nb.njit(cache=True, inline="always", fastmath=FAST)
-def exp_nonpositive(x, k, ib):
-    """x[:k] <- exp(x[:k]) in place, for x ≤ 0 (x < -700 gives ~1e-304, i.e. 0 here).
+#: 1.5 * 2**52: adding it to an integer-valued float n (|n| < 2**51) puts n in the low bits
+_SHIFTER = 6755399441055744.0
+_SHIFTER_BITS = 0x4338000000000000
+
+
+#: fused multiply-add allowed, but no reassociation (it would undo the shifter trick)
+CONTRACT = {"contract", "arcp", "nsz"}
+
+
+@nb.njit(cache=True, fastmath=CONTRACT)
+def exp_shifted(x, k, shift, ib):
+    """x[:k] <- exp(x[:k] - shift) in place, for x ≤ shift (x - shift < -700 gives ~1e-304).
 
     Cody-Waite reduction x = n ln2 + r, |r| ≤ ln2/2, degree-13 Taylor polynomial for e^r
-    (truncation < 2e-16), scaling by 2^n through the exponent bits (scratch ``ib`` (≥k,)
-    int64). Relative error ~1e-15; unlike libm exp the loop vectorises.
+    (truncation < 2e-16), scaling by 2^n built in the exponent bits: n + 1.5·2^52 holds n in
+    its low bits, so no float → int64 conversion (which AVX2 lacks) is needed and every loop
+    vectorises. Scratch ``ib`` (≥k,) int64. Relative error ~2e-15.
     """
+    fb = ib[:k].view(np.float64)
     for a in range(k):
-        t = max(x[a], -700.0)
-        n = np.floor(t * _LOG2E + 0.5)
-        r = t - n * _LN2_HI - n * _LN2_LO
+        t = max(x[a] - shift, -700.0)
+        n = np.rint(t * _LOG2E)
+        r = (t - n * _LN2_HI) - n * _LN2_LO
         q = 1.0 / 6227020800.0
         q = q * r + 1.0 / 479001600.0
         q = q * r + 1.0 / 39916800.0
@@ -78,7 +89,14 @@ def exp_nonpositive(x, k, ib):
         q = q * r + 0.5
         q = q * r + 1.0
         x[a] = q * r + 1.0
-        ib[a] = (np.int64(n) + 1023) << 52
-    scale = ib[:k].view(np.float64)
+        fb[a] = n + _SHIFTER
     for a in range(k):
-        x[a] *= scale[a]
+        ib[a] = (ib[a] - (_SHIFTER_BITS - 1023)) << 52
+    for a in range(k):
+        x[a] *= fb[a]
+
+
+@nb.njit(cache=True)
+def exp_nonpositive(x, k, ib):
+    """x[:k] <- exp(x[:k]) in place, for x ≤ 0 (see :func:`exp_shifted`)."""
+    exp_shifted(x, k, 0.0, ib)

@@ -62,7 +62,9 @@ class SupportGrid:
         self.tree = None
         lo = (self.nodes - radii[:, None]).min(axis=0)
         extent = (self.nodes + radii[:, None]).max(axis=0) - lo
-        cell = float(np.median(radii)) * (0.25 * d)
+        # cell side: fewer candidates per point (≈ 1.4 × the support nodes for d = 2) against
+        # more entries (each node in ≈ 70 cells for d = 2)
+        cell = float(np.median(radii)) * (0.35 if d == 2 else 0.25 * d)
         max_cells = max(16 * n, 4096)
         while np.prod(np.floor(extent / cell) + 1.0) > max_cells:
             cell *= 1.25
@@ -85,11 +87,9 @@ class SupportGrid:
             return Cells(points, np.arange(m, dtype=np.int64), indptr, indices,
                          np.ascontiguousarray(self.nodes[indices].T), self.radii2[indices],
                          np.arange(m, dtype=np.int64))
-        c = (points - self.lo) / self.cell
-        inside = np.all((c >= 0) & (c < self.shape), axis=1)
-        cid = np.where(inside, np.clip(np.nan_to_num(c), 0, self.shape - 1).astype(np.int64)
-                       @ self.strides, -1)
-        visit = np.argsort(cid, kind="stable").astype(np.int64)
+        cid = np.empty(m, dtype=np.int64)
+        _cell_ids(points, self.lo, self.cell, self.shape, self.strides, cid)
+        visit = _sort_by_cell(cid, len(self.starts) - 1)
         return Cells(points, cid, self.starts, self.entries, self.entry_x, self.entry_r2, visit)
 
     def cells_within(self, points: np.ndarray, radius: float) -> Cells:
@@ -156,7 +156,10 @@ class Cells:
     def count(self) -> np.ndarray:
         """indptr (m+1,) of the CSR layout of the support nodes of every point."""
         counts = np.empty(len(self.points), dtype=np.int64)
-        _count_kernel(*self.args(), counts)
+        if self.points.shape[1] == 2:
+            _count_kernel_2d(*self.args(), counts)
+        else:
+            _count_kernel(*self.args(), counts)
         indptr = np.zeros(len(self.points) + 1, dtype=np.int64)
         np.cumsum(counts, out=indptr[1:])
         return indptr
@@ -164,7 +167,10 @@ class Cells:
 
 @nb.njit(cache=True)
 def _register(nodes, radii, lo, cell, shape, strides):
-    """CSR cell -> node lists, each node in every cell its support's bounding box touches."""
+    """CSR cell -> node lists, each node in every cell its support ball reaches: the cells of
+    the ball's bounding box nearer to the node than r_a + 1e-6 cell (a margin for round-off in
+    the cell of a point). Registering by ball, not box, trims ~15% of the candidates (d = 2).
+    """
     n, d = nodes.shape
     n_cells = 1
     for k in range(d):
@@ -182,6 +188,8 @@ def _register(nodes, radii, lo, cell, shape, strides):
             entries = np.empty(starts[n_cells], dtype=np.int64)
             counts[:] = 0
         for a in range(n):
+            ra = radii[a] + 1e-6 * cell  # margin for round-off in the cell of a point
+            r2 = ra * ra
             for k in range(d):
                 first[k] = min(max(int(np.floor((nodes[a, k] - radii[a] - lo[k]) / cell)), 0),
                                shape[k] - 1)
@@ -190,11 +198,16 @@ def _register(nodes, radii, lo, cell, shape, strides):
                 cur[k] = first[k]
             while True:
                 cid = 0
+                gap2 = 0.0  # squared distance from node a to the cell (a box)
                 for k in range(d):
                     cid += cur[k] * strides[k]
-                if sweep == 1:
-                    entries[starts[cid] + counts[cid]] = a
-                counts[cid] += 1
+                    c_lo = lo[k] + cur[k] * cell
+                    g = max(c_lo - nodes[a, k], nodes[a, k] - (c_lo + cell), 0.0)
+                    gap2 += g * g
+                if gap2 <= r2:  # the support ball reaches the cell
+                    if sweep == 1:
+                        entries[starts[cid] + counts[cid]] = a
+                    counts[cid] += 1
                 k = d - 1
                 while k >= 0 and cur[k] == last[k]:
                     cur[k] = first[k]
@@ -203,6 +216,38 @@ def _register(nodes, radii, lo, cell, shape, strides):
                     break
                 cur[k] += 1
     return starts, entries
+
+
+@nb.njit(parallel=True, cache=True)
+def _cell_ids(points, lo, cell, shape, strides, cid):
+    """cid[i]: the grid cell containing point i, -1 outside the grid (or NaN coordinates)."""
+    m, d = points.shape
+    for i in nb.prange(m):
+        c = 0
+        for k in range(d):
+            t = (points[i, k] - lo[k]) / cell
+            if not (t >= 0.0 and t < shape[k]):
+                c = -1
+                break
+            c += int(t) * strides[k]
+        cid[i] = c
+
+
+@nb.njit(cache=True)
+def _sort_by_cell(cid, n_cells):
+    """The points in order of their cell (those outside the grid first), a stable counting
+    sort: the same order as np.argsort(cid, kind="stable")."""
+    first = np.zeros(n_cells + 2, dtype=np.int64)
+    for c in cid:
+        first[c + 2] += 1
+    for c in range(1, n_cells + 2):
+        first[c] += first[c - 1]
+    visit = np.empty(len(cid), dtype=np.int64)
+    for i in range(len(cid)):
+        c = cid[i] + 1
+        visit[first[c]] = i
+        first[c] += 1
+    return visit
 
 
 @nb.njit(cache=True, inline="always")
@@ -231,6 +276,25 @@ def _count_kernel(points, visit, cell, starts, entries, entry_x, entry_r2, count
         i = visit[ii]
         counts[i] = scan(points[i], cell[i], starts, entries, entry_x, entry_r2, dummy, 0,
                          False)
+
+
+@nb.njit(parallel=True, cache=True)
+def _count_kernel_2d(points, visit, cell, starts, entries, entry_x, entry_r2, counts):
+    """:func:`_count_kernel` for d = 2, written out so that the scan of a cell vectorises."""
+    for ii in nb.prange(points.shape[0]):
+        i = visit[ii]
+        ci = cell[i]
+        if ci < 0:
+            counts[i] = 0
+            continue
+        x0 = points[i, 0]
+        x1 = points[i, 1]
+        n = 0
+        for q in range(starts[ci], starts[ci + 1]):
+            t0 = x0 - entry_x[0, q]
+            t1 = x1 - entry_x[1, q]
+            n += np.int64(t0 * t0 + t1 * t1 < entry_r2[q])
+        counts[i] = n
 
 
 @nb.njit(parallel=True, cache=True)

@@ -32,7 +32,7 @@ class QuadraturePoints:
     weights: np.ndarray       # (m,) w_g J ψ_κ
     positions: np.ndarray     # (m, D)
     tangents: np.ndarray      # (m, d, D)
-    geometry: dict = field(default_factory=dict)  # normal, H, K, metric ... (d=2, D=3)
+    geometry: dict = field(default_factory=dict)  # dg.Geometry: metric, J, normal, H, K ...
 
 
 class Atlas:
@@ -138,8 +138,11 @@ class Atlas:
         return self.labels_
 
     def build_charts(self, progress=lambda it, **kw: it) -> list[Chart]:
-        """One chart per patch (after :meth:`partition`)."""
+        """One chart per patch (after :meth:`partition`). With least_squares_fit, the control
+        points interpolate the points chart by chart (least_squares_scope='chart') or are fitted
+        once for the whole atlas (least_squares_scope='global', Paper 2 App. B)."""
         s = self.settings
+        per_chart = s.least_squares_scope == "chart"
         self.charts_, self.support_ = [], []
         L = int(self.labels_.max()) + 1
         for k in progress(range(L), total=L, desc="charts"):
@@ -147,8 +150,12 @@ class Atlas:
             J, psi = self._control_set(members)
             xi = self._embeddings.get(J.tobytes())
             self.charts_.append(build_chart(self.points_, J, self.make_embedder(), self.make_lme,
-                                            s.least_squares_fit, xi=xi))
+                                            s.least_squares_fit and per_chart, xi=xi))
             self.support_.append(psi)
+        if s.least_squares_fit and not per_chart:
+            from .surface_fit import fit_control_points
+
+            self.control_point_fit_ = fit_control_points(self, self.points_)
         return self.charts_
 
     def build_quadrature(self, progress=lambda it, **kw: it, need_second: bool = True,
@@ -183,7 +190,7 @@ class Atlas:
             chart=np.concatenate([np.full(len(c.weights), k) for k, c in enumerate(q)]),
             weights=np.concatenate([c.weights for c in q]),
             positions=np.concatenate([c.positions for c in q]),
-            tangents=T, geometry=dg.surface_geometry(T, S))
+            tangents=T, geometry=dg.manifold_geometry(T, S))
 
     def integrate(self, f: Callable[[QuadraturePoints], np.ndarray], per_chart: bool = False):
         """∫_M f dM ≈ Σ_κ Σ_g w_g J_κ ψ_κ f (thesis §3.4); f gets a :class:`QuadraturePoints`.
@@ -195,12 +202,43 @@ class Atlas:
         parts = np.bincount(qp.chart, weights=vals, minlength=len(self.quadrature_))
         return parts if per_chart else float(parts.sum())
 
-    def redundancy(self) -> float:
-        """Quadrature redundancy (Paper 2 Fig. 1): Gauss points used over all charts, divided
-        by the Gauss points one chart-free triangulation of the points would need
-        (2 N triangles for a closed surface of N points, times the rule size)."""
-        n_used = sum(len(c.weights) for c in self.quadrature_)
-        rule = simplex_rule(self.charts_[0].xi_nodes.shape[1],
-                            self.settings.quadrature_order).n_points
-        n_tri = 2 * self.points_.shape[0] if self.points_.shape[1] == 3 else self.points_.shape[0]
-        return n_used / (n_tri * rule)
+    def redundancy(self, definition: str = "used") -> float:
+        """Quadrature redundancy: Gauss points of all charts over those of one cover of M.
+
+        definition='used' (default, kept for the studies): the Gauss points kept (ψ_κ > tol_pu)
+            over n_cover × rule size, with n_cover the simplices one chart-free triangulation
+            of the N points needs: 2N triangles for a closed surface (Euler), N segments for a
+            closed curve; for d ≥ 3 (no such count) the PU-weighted count of 'paper2'.
+        definition='paper2' (Paper 2 §1 and Fig. 1: "the ratio between the number of
+            quadrature points needed ... and the number of quadrature points if no overlap at
+            all was needed"): every Gauss point evaluated, i.e. all those of the simplices that
+            meet supp ψ_κ (including those then dropped for ψ_κ ≈ 0 or outside the LME
+            domain), over Σ_κ Σ_g ψ_κ(x_g), the Gauss points counted with their share of the
+            partition of unity. Σ_κ ψ_κ = 1 makes the latter the count of one non-overlapping
+            cover at the charts' own density, for any d and with or without boundary.
+        See :meth:`redundancy_report` for all the counts.
+        """
+        r = self.redundancy_report()
+        if definition == "used":
+            return r["used_over_triangulation"] if np.isfinite(r["used_over_triangulation"]) \
+                else r["used_over_pu_count"]
+        if definition == "paper2":
+            return r["paper2"]
+        raise InputError(f"definition = {definition!r} is invalid; use 'used' or 'paper2'.")
+
+    def redundancy_report(self) -> dict[str, float]:
+        """Gauss point counts behind :meth:`redundancy` and their ratios."""
+        q = self.quadrature_
+        d = self.charts_[0].xi_nodes.shape[1]
+        rule = simplex_rule(d, self.settings.quadrature_order).n_points
+        used = float(sum(len(c.weights) for c in q))
+        evaluated = float(sum(c.n_candidates for c in q))
+        pu_count = float(sum(c.pu.sum() for c in q))
+        N = self.points_.shape[0]
+        n_cover = {1: N, 2: 2 * N}.get(d)
+        tri = np.nan if n_cover is None else float(n_cover * rule)
+        return {"gauss_points_used": used, "gauss_points_evaluated": evaluated,
+                "single_cover_pu_count": pu_count, "single_cover_triangulation": tri,
+                "used_over_triangulation": used / tri if n_cover else np.nan,
+                "used_over_pu_count": used / pu_count,
+                "paper2": evaluated / pu_count}

@@ -8,8 +8,10 @@ points on a Delaunay triangulation of Ξ_κ,
     ∫_M ψ_κ f dM ≈ Σ_g w_g J_κ(ξ_g) ψ_κ(φ_κ(ξ_g)) f(φ_κ(ξ_g)),   J_κ = sqrt(det Dφᵀ Dφ),
 
 keeping only the points where ψ_κ ∘ φ_κ > tol_pu and where the LME chart exists (inside
-the convex hull of Ξ_κ). Optionally the control points are refitted so that the chart passes
-through the samples (Paper 2 App. B, here per chart: φ_κ(ξ_a) = x_a for a ∈ J_κ).
+the convex hull of Ξ_κ) — Delaunay simplices of Ξ_κ for d ≥ 2 (triangles, tetrahedra), the
+intervals between consecutive sorted nodes for d = 1. Optionally the control points are
+refitted so that the chart passes through the samples (Paper 2 App. B, here per chart:
+φ_κ(ξ_a) = x_a for a ∈ J_κ; the global fit of App. B is in :mod:`.surface_fit`).
 """
 from __future__ import annotations
 
@@ -167,7 +169,8 @@ class Chart:
         return X, T, S, outside
 
     def geometry(self, xi: np.ndarray) -> dict[str, np.ndarray]:
-        """Point, tangents, metric, J, normal, b, H, K at parametric points inside the hull."""
+        """Point, tangents, second derivatives and the :class:`differential_geometry.Geometry`
+        (metric, J; normal, b, H, K for a surface in R^3; the rest on access)."""
         X, T, S, outside = self.evaluate(xi, order=2)
         out = dg.surface_geometry(T, S)
         out.update(position=X, tangents=T, second_derivatives=S, outside=outside)

@@ -65,7 +65,7 @@ def basis_at_nodes(atlas, nodes: np.ndarray, order: int = 1):
     """(basis, chart, xi) at control points ``nodes``: each in its best chart (node_charts)."""
     chart, local = node_charts(atlas, nodes)
     xi = np.stack([atlas.charts_[k].xi_nodes[j] for k, j in zip(chart, local)]) \
-        if len(chart) else np.zeros((0, 2))
+        if len(chart) else np.zeros((0, atlas.charts_[0].xi_nodes.shape[1]))
     return basis_at(atlas, chart, xi, order), chart, xi
 
 

@@ -8,6 +8,7 @@ builds the chart and measures it); :func:`embedding_defects` gives the measures.
 """
 from __future__ import annotations
 
+import math
 from typing import Callable
 
 import numpy as np
@@ -124,7 +125,7 @@ def refine_partition(labels: np.ndarray, adjacency: csr_matrix,
 
 def embedding_defects(points: np.ndarray, xi: np.ndarray, n_neighbors: int = 8
                       ) -> dict[str, float]:
-    """How far an embedding ξ (n, d=2) of points (n, D) is from a good chart.
+    """How far an embedding ξ (n, d) of points (n, D) is from a good chart.
 
     - ``stress``: Σ_edges (|ξ_a − ξ_b| − |P_a − P_b|)² / Σ_edges |P_a − P_b|² over the k-NN
       edges (a normalised version of the stress E_S of thesis Appendix E.1);
@@ -132,14 +133,21 @@ def embedding_defects(points: np.ndarray, xi: np.ndarray, n_neighbors: int = 8
       in R^3 (vertices ordered counter-clockwise in ξ) have opposite normals: a fold;
     - ``max_distortion`` / ``distortion``: largest / 95th-percentile ratio of singular values of
       the affine map ξ → P over the non-sliver triangles (edges < 3 median k-NN distances).
+
+    The triangle measures are those of a surface in R^3; other (d, D) use the simplices of
+    :func:`simplex_defects`.
     """
     row, col = knn_edges(points, n_neighbors)
     dx = np.linalg.norm(points[row] - points[col], axis=1)
     dxi = np.linalg.norm(xi[row] - xi[col], axis=1)
     out = {"stress": float(np.sum((dxi - dx) ** 2) / np.sum(dx**2))}
-    if xi.shape[1] != 2 or points.shape[1] != 3 or len(xi) < 4:
+    d = xi.shape[1]
+    if len(xi) < d + 2:
         r = float(np.max(dxi / dx) / np.min(dxi / dx))
         out.update(flip_fraction=0.0, max_distortion=r, distortion=r)
+        return out
+    if d != 2 or points.shape[1] != 3:
+        out.update(simplex_defects(points, xi, float(np.median(dx))))
         return out
     tri = Delaunay(xi)
     S = tri.simplices.copy()
@@ -173,3 +181,63 @@ def embedding_defects(points: np.ndarray, xi: np.ndarray, n_neighbors: int = 8
     out["max_distortion"] = float(np.max(ratio))
     out["distortion"] = float(np.quantile(ratio, 0.95))
     return out
+
+
+def regular_simplex_volume(d: int, edge: np.ndarray) -> np.ndarray:
+    """d-volume of the regular d-simplex of edge length ``edge``: edge^d/d!·sqrt((d+1)/2^d)."""
+    return edge**d / math.factorial(d) * math.sqrt((d + 1) / 2.0**d)
+
+
+def simplex_defects(points: np.ndarray, xi: np.ndarray, h: float) -> dict[str, float]:
+    """Fold and distortion measures of an embedding ξ (n, d) of points (n, D), any d and D.
+
+    Simplices: consecutive nodes in ξ order for d = 1, the Delaunay simplices of ξ for d ≥ 2.
+    On each, the affine map ξ → P has the (D, d) gradient F = E_P E_ξ⁻¹ (edge matrices).
+
+    - ``flip_fraction``: fraction of pairs of adjacent good simplices with det(F_sᵀ F_t) < 0:
+      the map turns over across their common face, a fold (for a surface in R^3 this is the
+      sign of n_s·n_t, Binet–Cauchy). For d = 1 a segment longer than 3 h in R^D (the
+      embedding interleaves two distant pieces of the curve) also counts as a fold.
+    - ``max_distortion`` / ``distortion``: largest / 95th-percentile singular-value ratio of
+      F over the good simplices; for d = 1 (one singular value per segment) the ratio of the
+      95th to the 5th percentile of the stretch |ΔP|/|Δξ| instead.
+
+    Good simplices have all edges in R^D below 3 h (h: median k-NN distance) and, for d ≥ 2,
+    ξ-volume above 0.2 of the regular simplex of their rms edge (no hull slivers).
+    """
+    d = xi.shape[1]
+    if d == 1:
+        o = np.argsort(xi[:, 0])
+        dP = np.diff(points[o], axis=0)
+        lengths = np.linalg.norm(dP, axis=1)
+        stretch = lengths / np.maximum(np.diff(xi[o, 0]), 1e-300)
+        turn = np.einsum("ij,ij->i", dP[1:], dP[:-1]) < 0
+        jump = lengths > 3.0 * h
+        folds = np.concatenate([turn, jump])
+        q05, q95 = np.quantile(stretch, [0.05, 0.95])
+        return {"flip_fraction": float(np.mean(folds)),
+                "max_distortion": float(stretch.max() / max(stretch.min(), 1e-300)),
+                "distortion": float(q95 / max(q05, 1e-300))}
+    tri = Delaunay(xi)
+    S = tri.simplices
+    E_xi = xi[S[:, 1:]] - xi[S[:, :1]]                       # (t, d, d) rows: edges
+    E_P = points[S[:, 1:]] - points[S[:, :1]]                # (t, d, D)
+    vol = np.abs(np.linalg.det(E_xi)) / math.factorial(d)
+    pairs = np.array([(i, j) for i in range(d + 1) for j in range(i + 1, d + 1)])
+    edge_xi = np.linalg.norm(xi[S[:, pairs[:, 0]]] - xi[S[:, pairs[:, 1]]], axis=2)
+    edge_P = np.linalg.norm(points[S[:, pairs[:, 0]]] - points[S[:, pairs[:, 1]]], axis=2)
+    rms = np.sqrt(np.mean(edge_xi**2, axis=1))
+    good = (edge_P.max(axis=1) < 3.0 * h) & (vol > 0.2 * regular_simplex_volume(d, rms))
+    F = np.zeros((len(S), points.shape[1], d))
+    F[good] = np.swapaxes(np.linalg.solve(E_xi[good], E_P[good]), 1, 2)  # F E_ξᵀ = E_Pᵀ
+    t_idx = np.repeat(np.arange(len(S)), d + 1)
+    s_idx = tri.neighbors.ravel()
+    pair = (s_idx > t_idx) & good[t_idx] & good[np.maximum(s_idx, 0)]
+    flip = 0.0
+    if pair.any():
+        G = np.einsum("tid,tie->tde", F[t_idx[pair]], F[s_idx[pair]])
+        flip = float(np.mean(np.linalg.det(G) < 0))
+    sv = np.linalg.svd(F[good], compute_uv=False)
+    ratio = sv[:, 0] / np.maximum(sv[:, -1], 1e-300) if len(sv) else np.ones(1)
+    return {"flip_fraction": flip, "max_distortion": float(np.max(ratio)),
+            "distortion": float(np.quantile(ratio, 0.95))}

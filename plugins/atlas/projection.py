@@ -42,7 +42,8 @@ class Projection:
     xi: np.ndarray          # (m, d) pre-image ξ_κ(x) in that chart
     point: np.ndarray       # (m, D) projected point φ_κ(ξ)
     distance: np.ndarray    # (m,) |x − φ_κ(ξ)|
-    normal: Optional[np.ndarray]  # (m, 3) unit normal (surfaces in R^3), towards x if x is off M
+    normal: Optional[np.ndarray]  # (m, D) unit normal (hypersurfaces, D = d + 1), towards x
+    #                               if x is off M; None in higher codimension
     converged: np.ndarray   # (m,) Newton reached a stationary point inside the chart
     n_iter: np.ndarray      # (m,) Newton iterations in the chosen chart
 
@@ -254,8 +255,8 @@ def closest_point(atlas, x, chart: Optional[int] = None, tol: float = 1e-12,
     out.distance[r], out.converged[r], out.n_iter[r] = (
         res.distance[first], res.converged[first], res.n_iter[first])
     out.distance[~np.isfinite(out.distance)] = np.nan
-    if d == 2 and D == 3:
-        out.normal = np.full((m, 3), np.nan)
+    if D == d + 1:  # hypersurface: a unit normal exists (surface in R^3, curve in R^2, ...)
+        out.normal = np.full((m, D), np.nan)
         T = res.tangents[first]
         ok = np.isfinite(T).all(axis=(1, 2))
         n = dg.unit_normal(T[ok])

@@ -24,6 +24,10 @@ class AtlasSettings:
     tol_pu: float = 1e-6
     quadrature_order: int = 6
     least_squares_fit: bool = True
+    least_squares_scope: str = "chart"    # 'chart': each chart interpolates its control
+    #                                       points; 'global': one set of control points for
+    #                                       all charts, the blend fits the points (Paper 2
+    #                                       App. B; surface_fit.py)
     chart_margin: float = 3.0             # extra control points within margin·h of supp ψ_κ
     graph_neighbors: int = 10
     max_stress: float = 0.02              # accept a patch's embedding below this stress ...
@@ -45,6 +49,10 @@ class AtlasSettings:
                 raise ConfigError(f"{name} = {v!r} is invalid; it must be a finite number > 0.")
         if self.n_patches is not None and self.n_patches < 1:
             raise ConfigError(f"n_patches = {self.n_patches!r} is invalid; use None or >= 1.")
+        if self.least_squares_scope not in ("chart", "global"):
+            raise ConfigError(f"least_squares_scope = {self.least_squares_scope!r} is invalid; "
+                              "use 'chart' (per-chart interpolation) or 'global' (Paper 2 "
+                              "App. B: one least-squares fit of the blended atlas).")
         if self.markers_per_patch < 8:
             raise ConfigError(f"markers_per_patch = {self.markers_per_patch!r} is invalid; "
                               "it must be >= 8 (a patch needs enough markers to be embedded).")

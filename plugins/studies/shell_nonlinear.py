@@ -199,12 +199,14 @@ class ShellNonlinearStudy:
         with xr.open_dataset(path) as old:
             U = old["nodal_displacement"].isel(increment=-1).values
             lam = float(old["load_factor"].isel(increment=-1))
+            negative = (int(old["negative_pivots"].isel(increment=-1))
+                        if "negative_pivots" in old else -1)
         if U.shape != model.nodes.shape:
             from pointatlas.errors import InputError
 
             raise InputError(f"{path} holds {U.shape[0]} nodes but this model has "
                              f"{model.nodes.shape[0]}: resume with the same source and settings.")
-        return Increment(lam, U, 0, [], {}, -1, True, 0.0)
+        return Increment(lam, U, 0, [], {}, negative, negative == 0, 0.0)
 
     def _dataset(self, model, records, values, names):
         from .shell_path_results import path_dataset

@@ -116,6 +116,9 @@ def follow_arc_length(eq, path: PathSettings, on_increment=None, log=None,
     nominal = path.max_load_factor / path.n_increments
     mask = arc_mask(eq, U.size)
     done: list[Increment] = []
+    # negative pivots before the first increment: none in the unloaded state, the stored
+    # count of a resumed one (-1 if unknown: no branch switch until it is known)
+    start_negative = 0 if start is None else start.negative_pivots
     # the first increment is load controlled; its length |ΔU| is the arc length Δs₀ (the
     # linear predictor overestimates the response of a stiffening shell by orders of
     # magnitude, and a sphere of that radius may never meet the path)
@@ -193,8 +196,9 @@ def follow_arc_length(eq, path: PathSettings, on_increment=None, log=None,
         done.append(make_increment(eq, U, mu, lam, it, residuals, negative, t0))
         if on_increment is not None:
             on_increment(done[-1])
+        before = done[-2].negative_pivots if len(done) >= 2 else start_negative
         if (path.branch_switching and switches < path.max_branch_switches and rising
-                and len(done) >= 2 and negative > done[-2].negative_pivots >= 0):
+                and negative > before >= 0):
             t0 = time.perf_counter()
             switched = switch_branch(eq, path, U, mu, lam, ds, dU_prev, mask, log)
             if switched is not None:

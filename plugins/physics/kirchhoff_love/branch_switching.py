@@ -25,23 +25,27 @@ from typing import Optional
 import numpy as np
 
 
-def negative_modes(system, count: int, extra: int = 4, tol: float = 1e-8):
-    """(eigenvalues, vectors) of the factorised K_T + ρCᵀC (:class:`.solver.ConstrainedSystem`)
-    that are negative, most negative first, by shift-invert Lanczos around 0 (scipy
-    ``eigsh``) reusing the factorisation: one back-substitution per Lanczos step.
+def negative_modes(system, count: int, tol: float = 1e-8, max_iter: int = 300):
+    """(eigenvalues, vectors) of the factorised K_T + ρCᵀC (:class:`.solver.ConstrainedSystem`):
+    the ``count`` negative eigenvalues nearest 0, most negative first, by shift-invert Lanczos
+    (scipy ``eigsh``, σ = 0) reusing the factorisation: one back-substitution per step.
 
-    ``count`` is the number of negative pivots; ``extra`` more eigenpairs nearest 0 are
-    computed because weakly held (ghost) DOFs add small positive eigenvalues near 0.
-    Units: eigenvalues in force per length (stiffness)."""
-    from scipy.sparse.linalg import LinearOperator, eigsh
+    The Lanczos iteration targets the most negative shifted values ν = 1/λ, i.e. the negative
+    eigenvalues nearest 0. (Targeting the largest |ν| would chase the weakly held ghost DOFs,
+    whose small positive eigenvalues cluster near 0.) Units: force per length (stiffness)."""
+    from scipy.sparse.linalg import ArpackNoConvergence, LinearOperator, eigsh
 
     A = system.matrix
     n = A.shape[0]
-    k = int(min(max(count, 1) + extra, n - 2))
+    k = int(min(max(count, 1), n - 2))
     if k < 1:
         return np.zeros(0), np.zeros((n, 0))
     inverse = LinearOperator(A.shape, matvec=system.inverse, dtype=float)
-    vals, vecs = eigsh(A, k=k, sigma=0.0, which="LM", OPinv=inverse, tol=tol)
+    try:
+        vals, vecs = eigsh(A, k=k, sigma=0.0, which="SA", OPinv=inverse, tol=tol,
+                           maxiter=max_iter)
+    except ArpackNoConvergence as exc:
+        vals, vecs = exc.eigenvalues, exc.eigenvectors
     order = np.argsort(vals)
     vals, vecs = vals[order], vecs[:, order]
     keep = vals < 0

@@ -225,7 +225,7 @@ def switch_branch(eq, path: PathSettings, U, mu, lam: float, ds: float, step, ma
 
     system = eq.system(U)
     count = system.negative_pivots
-    phi = bifurcation_mode(system, step, mask)
+    phi = bifurcation_mode(system, step, mask, log=log)
     if phi is None:
         if log is not None:
             log.info("λ = %.5g: %d negative pivots, the unstable mode is along the path (a "

@@ -9,8 +9,8 @@ the load, φᵀF = 0, so the path tangent has no component along it; at a limit 
 tangent *is* φ (Riks 1984, "Bifurcation and stability, a numerical approach", in Innovative
 Methods for Nonlinear Problems; Wriggers & Simo 1990, Commun. Appl. Numer. Methods 6:303).
 Hence the test used here: an increment whose count of negative pivots grew while λ kept
-growing, and whose step ΔU is nearly orthogonal to the new unstable mode, has crossed a
-bifurcation.
+growing, and whose step ΔU is not aligned with the new unstable mode, has crossed a
+bifurcation (along a regular path the sign change of det K_T without a turn of λ marks one).
 
 The switch is the eigenvector injection of Wagner & Wriggers (1988, "A simple method for
 the calculation of postcritical branches", Eng. Comput. 5:103–109): the next arc-length
@@ -52,15 +52,18 @@ def negative_modes(system, count: int, tol: float = 1e-8, max_iter: int = 300):
     return vals[keep], vecs[:, keep]
 
 
-def bifurcation_mode(system, step: np.ndarray, mask: np.ndarray,
-                     max_cosine: float = 0.5) -> Optional[np.ndarray]:
-    """The most unstable eigenvector of ``system`` if the state is past a simple bifurcation
-    crossed by ``step`` (the last increment's ΔU), else None.
+def bifurcation_mode(system, step: np.ndarray, mask: np.ndarray, max_cosine: float = 0.95,
+                     log=None) -> Optional[np.ndarray]:
+    """The direction to inject at a bifurcation just crossed by ``step`` (the last
+    increment's ΔU, along which λ kept growing), or None.
 
-    It is a bifurcation when |cos(φ, ΔU)| in the masked metric (control points of the
-    surface, :func:`.arc_length.arc_mask`) is below ``max_cosine``: the path did not turn
-    along φ as it does at a limit point. φ is normalised to unit masked length with its
-    largest entry positive (a reproducible choice of the two symmetric branches)."""
+    φ is the eigenvector of the most negative eigenvalue nearest 0. If |cos(φ, ΔU)| in the
+    masked metric (control points of the surface, :func:`.arc_length.arc_mask`) is at least
+    ``max_cosine`` the unstable mode is the path direction itself (a limit point seen from
+    its far side) and None is returned. Otherwise the part of φ orthogonal to ΔU is injected
+    (for a symmetric bifurcation φ ⊥ ΔU already; an imperfect or asymmetric one mixes them),
+    normalised to unit masked length with its largest entry positive (a reproducible choice
+    of the two branches)."""
     count = getattr(system, "negative_pivots", -1)
     if count <= 0:
         return None
@@ -68,8 +71,13 @@ def bifurcation_mode(system, step: np.ndarray, mask: np.ndarray,
     if vals.size == 0:
         return None
     phi = vecs[:, 0]
-    if mode_cosine(phi, step, mask) >= max_cosine:
+    cosine = mode_cosine(phi, step, mask)
+    if log is not None:
+        log.info("  critical mode: eigenvalue %.4g, |cos(φ, ΔU)| = %.3f", vals[0], cosine)
+    if cosine >= max_cosine:
         return None
+    t = mask * step
+    phi = phi - (float(phi @ t) / float(step @ t)) * step
     phi = phi / float(np.sqrt(phi @ (mask * phi)))
     return phi if phi[np.argmax(np.abs(phi))] > 0 else -phi
 

@@ -34,6 +34,7 @@ from typing import Optional
 
 import numpy as np
 
+from .branch_switching import confirmed_negative_count
 from .incremental import (Increment, PathFollowingError, PathSettings, load_increment,
                           make_increment)
 
@@ -68,7 +69,7 @@ def arc_increment(eq, path: PathSettings, U0, mu0, lam0: float, ds: float, dU_pr
         DU, Dmu, lam = dlam * dUF, dlam * dmuF, lam0 + dlam
     else:
         DU, Dmu, lam = ds * predictor, np.zeros_like(mu0), lam0
-    residuals, negative = [], -1
+    residuals = []
     R, _ = eq.residual(U0 + DU, mu0 + Dmu, lam)
     for it in range(1, path.max_newton + 1):
         U = U0 + DU
@@ -91,7 +92,6 @@ def arc_increment(eq, path: PathSettings, U0, mu0, lam0: float, ds: float, dU_pr
             r = -b / (2 * a)
         step = dUR + r * dUF
         DU, Dmu, lam = DU + step, Dmu + dmuR + r * dmuF, lam + r
-        negative = sys.negative_pivots
         U, mu = U0 + DU, mu0 + Dmu
         R, _ = eq.residual(U, mu, lam)
         res = float(np.linalg.norm(R)) / eq.scale(lam, mu)
@@ -102,7 +102,7 @@ def arc_increment(eq, path: PathSettings, U0, mu0, lam0: float, ds: float, dU_pr
         if not np.isfinite(res):
             return None
         if res <= path.tol:
-            return U, mu, lam, it, residuals, negative
+            return U, mu, lam, it, residuals, confirmed_negative_count(sys)
     return None
 
 
@@ -224,7 +224,7 @@ def switch_branch(eq, path: PathSettings, U, mu, lam: float, ds: float, step, ma
     from .branch_switching import bifurcation_mode
 
     system = eq.system(U)
-    count = system.negative_pivots
+    count = confirmed_negative_count(system)
     phi = bifurcation_mode(system, step, mask, log=log)
     if phi is None:
         if log is not None:

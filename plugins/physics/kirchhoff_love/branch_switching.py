@@ -52,6 +52,24 @@ def negative_modes(system, count: int, tol: float = 1e-8, max_iter: int = 300):
     return vals[keep], vecs[:, keep]
 
 
+def confirmed_negative_count(system, max_modes: int = 6) -> int:
+    """Negative eigenvalues of the factorised tangent, checked: the pivot signs of the
+    unpivoted factorisation give the inertia only up to round-off, and K_T + ρCᵀC with a
+    large ρ and weakly held ghost DOFs is ill-conditioned enough for a tiny positive pivot
+    to come out negative. When the pivots report n > 0 negative values, Lanczos
+    (:func:`negative_modes`, up to ``max_modes``) confirms them; the count of negative
+    eigenvalues found is returned (n itself when all ``max_modes`` are negative, and the
+    pivot count when Lanczos fails)."""
+    count = getattr(system, "negative_pivots", -1)
+    if count <= 0:
+        return count
+    try:
+        vals, _ = negative_modes(system, min(count, max_modes))
+    except Exception:   # ARPACK failure: keep the pivot count
+        return count
+    return count if vals.size >= min(count, max_modes) else int(vals.size)
+
+
 def bifurcation_mode(system, step: np.ndarray, mask: np.ndarray, max_cosine: float = 0.95,
                      log=None) -> Optional[np.ndarray]:
     """The direction to inject at a bifurcation just crossed by ``step`` (the last

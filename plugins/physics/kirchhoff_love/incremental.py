@@ -25,7 +25,9 @@ energy backtracking cut the first steps to α = 1/8 and the increment did not co
 ``max_newton`` iterations (or produces NaN) is cut in half and retried from the last
 converged increment; below ``min_step`` the run stops cleanly with the converged increments
 kept and a message naming the remedies. The signs of the pivots of the factorised
-K_T + ρCᵀC flag unstable equilibria (negative pivots: not a minimum).
+K_T + ρCᵀC flag unstable equilibria (negative pivots: not a minimum); a negative count is
+confirmed by Lanczos on the same factorisation (:func:`.branch_switching.
+confirmed_negative_count`), since round-off can flip the sign of a tiny pivot.
 """
 from __future__ import annotations
 
@@ -155,17 +157,18 @@ def make_increment(eq, U, mu, lam, iterations, residuals, negative, t0) -> Incre
 def load_increment(eq, path: PathSettings, U0, mu0, lam: float, log=None):
     """Equilibrium at the load factor λ from (U0, μ0): L-BFGS stage then Newton with line
     search. (U, μ, iterations, residuals, negative pivots), or None if it did not converge."""
+    from .branch_switching import confirmed_negative_count
+
     U, mu = U0.copy(), mu0.copy()
     if path.lbfgs_iterations > 0 and eq.rho is not None:
         U, _ = eq.lbfgs(U, mu, lam, path.lbfgs_tol, path.lbfgs_iterations, log)
     R, W = eq.residual(U, mu, lam)
-    residuals, negative = [], -1
+    residuals = []
     for it in range(1, path.max_newton + 1):
         sys = eq.system(U)
         dU, dmu, _ = sys.solve(-R, lam * eq.g - eq.C @ U)
         if not np.all(np.isfinite(dU)):
             return None
-        negative = sys.negative_pivots
         scale = eq.scale(lam, mu + dmu)
         alpha, (R_new, W_new) = 1.0, eq.residual(U + dU, mu + dmu, lam)
         if path.line_search and float(np.linalg.norm(R)) > 1e-3 * scale:
@@ -180,7 +183,7 @@ def load_increment(eq, path: PathSettings, U0, mu0, lam: float, log=None):
             return None
         small_step = float(np.abs(dU).max()) <= 1e-10 * max(float(np.abs(U).max()), 1e-300)
         if res <= path.tol or (small_step and it >= 2):
-            return U, mu, it, residuals, negative
+            return U, mu, it, residuals, confirmed_negative_count(sys)
     return None
 
 

@@ -89,3 +89,16 @@ def test_the_critical_mode_is_the_lateral_one_and_a_limit_point_is_not_a_bifurca
     assert bifurcation_mode(system, np.array([0.0, 0.2, 0.0]), mask) is None
     # a stable state has no mode to switch to
     assert bifurcation_mode(eq.system(np.array([0.5, 0.0, 0.0])), np.ones(3), mask) is None
+
+
+def test_a_negative_pivot_is_confirmed_by_the_eigenvalues():
+    from pointatlas_physics.kirchhoff_love.branch_switching import confirmed_negative_count
+
+    eq = Pitchfork()
+    unstable = eq.system(np.array([1.2, 0.0, 0.0]))
+    assert unstable.negative_pivots == 1 and confirmed_negative_count(unstable) == 1
+    stable = eq.system(np.array([0.5, 0.0, 0.0]))
+    assert confirmed_negative_count(stable) == 0
+    # a pivot sign flipped by round-off (forced here) is not taken for an instability
+    stable.negative_pivots = 1
+    assert confirmed_negative_count(stable) == 0

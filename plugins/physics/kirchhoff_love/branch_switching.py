@@ -25,27 +25,34 @@ from typing import Optional
 import numpy as np
 
 
-def negative_modes(system, count: int, tol: float = 1e-8, max_iter: int = 300):
-    """(eigenvalues, vectors) of the factorised K_T + ρCᵀC (:class:`.solver.ConstrainedSystem`):
-    the ``count`` negative eigenvalues nearest 0, most negative first, by shift-invert Lanczos
-    (scipy ``eigsh``, σ = 0) reusing the factorisation: one back-substitution per step.
+def negative_modes(system, count: int, tol: float = 1e-8, max_iter: int = 100):
+    """(eigenvalues, vectors) of the factorised K_T + ρCᵀC (:class:`.solver.ConstrainedSystem`)
+    that are negative, most negative first, by shift-invert Lanczos (scipy ``eigsh``, σ = 0)
+    reusing the factorisation: one back-substitution per step. Units: force per length.
 
-    The Lanczos iteration targets the most negative shifted values ν = 1/λ, i.e. the negative
-    eigenvalues nearest 0. (Targeting the largest |ν| would chase the weakly held ghost DOFs,
-    whose small positive eigenvalues cluster near 0.) Units: force per length (stiffness)."""
+    First the ``count`` + 6 eigenvalues nearest 0 (largest |1/λ|; fast, and an instability
+    just crossed has its eigenvalue there); if none of them is negative, the most negative
+    shifted values 1/λ, i.e. the negative eigenvalues nearest 0 beyond the weakly held
+    (ghost) DOFs' cluster of small positive ones. That search converges quickly to an
+    isolated negative eigenvalue; when it does not converge in ``max_iter`` steps there is
+    none to isolate, and no negative eigenvalue is returned."""
     from scipy.sparse.linalg import ArpackNoConvergence, LinearOperator, eigsh
 
     A = system.matrix
     n = A.shape[0]
-    k = int(min(max(count, 1), n - 2))
-    if k < 1:
-        return np.zeros(0), np.zeros((n, 0))
     inverse = LinearOperator(A.shape, matvec=system.inverse, dtype=float)
-    try:
-        vals, vecs = eigsh(A, k=k, sigma=0.0, which="SA", OPinv=inverse, tol=tol,
-                           maxiter=max_iter)
-    except ArpackNoConvergence as exc:
-        vals, vecs = exc.eigenvalues, exc.eigenvectors
+    vals, vecs = np.zeros(0), np.zeros((n, 0))
+    for which, k in (("LM", max(count, 1) + 6), ("SA", max(count, 1))):
+        k = int(min(k, n - 2))
+        if k < 1:
+            break
+        try:
+            vals, vecs = eigsh(A, k=k, sigma=0.0, which=which, OPinv=inverse, tol=tol,
+                               maxiter=max_iter)
+        except ArpackNoConvergence as exc:
+            vals, vecs = exc.eigenvalues, exc.eigenvectors
+        if np.any(vals < 0):
+            break
     order = np.argsort(vals)
     vals, vecs = vals[order], vecs[:, order]
     keep = vals < 0
@@ -59,7 +66,7 @@ def confirmed_negative_count(system, max_modes: int = 6) -> int:
     to come out negative. When the pivots report n > 0 negative values, Lanczos
     (:func:`negative_modes`, up to ``max_modes``) confirms them; the count of negative
     eigenvalues found is returned (n itself when all ``max_modes`` are negative, and the
-    pivot count when Lanczos fails)."""
+    pivot count when ARPACK raises an error)."""
     count = getattr(system, "negative_pivots", -1)
     if count <= 0:
         return count

@@ -102,3 +102,12 @@ def test_a_negative_pivot_is_confirmed_by_the_eigenvalues():
     # a pivot sign flipped by round-off (forced here) is not taken for an instability
     stable.negative_pivots = 1
     assert confirmed_negative_count(stable) == 0
+
+
+def test_a_negative_eigenvalue_is_found_beyond_a_cluster_of_weak_ghost_modes():
+    import scipy.sparse as sp
+
+    d = np.r_[1e-6 + 1e-8 * np.arange(50), -0.01, np.linspace(1.0, 100.0, 400)]
+    system = ConstrainedSystem(sp.diags(d).tocsr(), csr_matrix((1, d.size)))
+    vals, vecs = negative_modes(system, system.negative_pivots)
+    assert vals.tolist() == pytest.approx([-0.01]) and abs(vecs[50, 0]) == pytest.approx(1.0)

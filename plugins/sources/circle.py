@@ -6,10 +6,13 @@ from typing import ClassVar, Optional
 
 import numpy as np
 
+from pointatlas.stores_config import stores_config
+
 from .parametric_curve import CURVE_CONSTRAINTS, ParametricCurve
 from .surface_source import require_positive
 
 
+@stores_config
 class Circle(ParametricCurve):
     """Circle of radius ``radius`` centred at the origin of R^2, γ(t) = R (cos t, sin t).
 
@@ -29,13 +32,6 @@ class Circle(ParametricCurve):
         **CURVE_CONSTRAINTS, "radius": "finite number > 0"}
     name: ClassVar[str] = "circle"
     closed: ClassVar[bool] = True
-
-    def __init__(self, *, n_points: int = 200, sampling: str = "structured",
-                 radius: float = 1.0, n_markers: Optional[int] = None):
-        self.n_points = n_points
-        self.sampling = sampling
-        self.radius = radius
-        self.n_markers = n_markers
 
     def _check(self) -> None:
         require_positive("radius", self.radius)

@@ -6,10 +6,13 @@ from typing import ClassVar, Optional
 
 import numpy as np
 
+from pointatlas.stores_config import stores_config
+
 from .parametric_curve import CURVE_CONSTRAINTS, ParametricCurve
 from .surface_source import require_positive
 
 
+@stores_config
 class Helix(ParametricCurve):
     """Helix γ(t) = (r cos t, r sin t, c t), t ∈ [0, 2π·turns], c = pitch/(2π).
 
@@ -34,16 +37,6 @@ class Helix(ParametricCurve):
         "pitch": "finite number > 0: rise per turn", "turns": "finite number > 0"}
     name: ClassVar[str] = "helix"
     closed: ClassVar[bool] = False
-
-    def __init__(self, *, n_points: int = 200, sampling: str = "structured",
-                 radius: float = 1.0, pitch: float = 1.0, turns: float = 2.0,
-                 n_markers: Optional[int] = None):
-        self.n_points = n_points
-        self.sampling = sampling
-        self.radius = radius
-        self.pitch = pitch
-        self.turns = turns
-        self.n_markers = n_markers
 
     def _check(self) -> None:
         for name in ("radius", "pitch", "turns"):

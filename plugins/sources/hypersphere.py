@@ -7,6 +7,8 @@ from typing import ClassVar, Optional
 
 import numpy as np
 
+from pointatlas.stores_config import stores_config
+
 from .lattices import fibonacci_band
 from .surface_source import COMMON_CONSTRAINTS, SurfaceSource, require, require_positive
 
@@ -47,6 +49,7 @@ def hyperspherical_angles(x: np.ndarray) -> np.ndarray:
     return ang
 
 
+@stores_config
 class Hypersphere(SurfaceSource):
     """Round sphere S^dim of radius ``radius`` centred at the origin of R^(dim+1).
 
@@ -71,14 +74,6 @@ class Hypersphere(SurfaceSource):
         "dim": "integer >= 1: intrinsic dimension n (ambient R^(n+1)); structured "
                "sampling needs n <= 3"}
     name: ClassVar[str] = "hypersphere"
-
-    def __init__(self, *, n_points: int = 2000, sampling: str = "structured",
-                 radius: float = 1.0, dim: int = 3, n_markers: Optional[int] = None):
-        self.n_points = n_points
-        self.sampling = sampling
-        self.radius = radius
-        self.dim = dim
-        self.n_markers = n_markers
 
     @property
     def intrinsic_dim(self) -> int:  # type: ignore[override]

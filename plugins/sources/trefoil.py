@@ -6,10 +6,13 @@ from typing import ClassVar, Optional
 
 import numpy as np
 
+from pointatlas.stores_config import stores_config
+
 from .parametric_curve import CURVE_CONSTRAINTS, ParametricCurve
 from .surface_source import require_positive
 
 
+@stores_config
 class TrefoilKnot(ParametricCurve):
     """Trefoil γ(t) = scale·(sin t + 2 sin 2t, cos t − 2 cos 2t, −sin 3t), t ∈ [0, 2π).
 
@@ -30,13 +33,6 @@ class TrefoilKnot(ParametricCurve):
         **CURVE_CONSTRAINTS, "scale": "finite number > 0: length unit of the knot"}
     name: ClassVar[str] = "trefoil"
     closed: ClassVar[bool] = True
-
-    def __init__(self, *, n_points: int = 400, sampling: str = "structured",
-                 scale: float = 1.0, n_markers: Optional[int] = None):
-        self.n_points = n_points
-        self.sampling = sampling
-        self.scale = scale
-        self.n_markers = n_markers
 
     def _check(self) -> None:
         require_positive("scale", self.scale)

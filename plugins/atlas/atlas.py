@@ -137,6 +137,20 @@ class Atlas:
             labels, self.adjacency_, self._acceptable, max_depth=s.max_refinement_depth)
         return self.labels_
 
+    def refinement_warning(self) -> Optional[str]:
+        """Why the atlas may be wrong, if patches still fail the chart test after
+        :meth:`partition` (the refinement limit accepts them anyway); else None."""
+        n_bad = int((~self.accepted_).sum())
+        if n_bad == 0:
+            return None
+        s = self.settings
+        return (f"{n_bad} of {self.accepted_.size} patch(es) still fail the chart test (fold, "
+                f"stress > {s.max_stress:g} or distortion > {s.max_distortion:g}) at the "
+                "refinement limit, so their charts may be folded and integrals, strains and "
+                "energies wrong there. Sample the surface more densely, lower markers_per_patch, "
+                "chart_margin, raise gamma_pu (a narrower partition of unity), or try another embedder (isomap for curved "
+                "strips such as thin pipes).")
+
     def build_charts(self, progress=lambda it, **kw: it) -> list[Chart]:
         """One chart per patch (after :meth:`partition`). With least_squares_fit, the control
         points interpolate the points chart by chart (least_squares_scope='chart') or are fitted

@@ -72,13 +72,9 @@ class SurfaceGeometry:
             atlas.partition(cloud.points, cloud.markers)
         ctx.log.info("%d markers -> %d METIS patches -> %d after recursive refinement",
                      atlas.markers_.shape[0], atlas.initial_n_patches_, atlas.labels_.max() + 1)
-        n_bad = int((~atlas.accepted_).sum())
-        if n_bad:
-            ctx.log.warning(
-                "%d patch(es) still fail the chart test (fold, stress > %g or distortion > %g) "
-                "at the refinement limit; integrals may be wrong there. Sample the surface more "
-                "densely, lower markers_per_patch/chart_margin, or try another embedder.",
-                n_bad, self.max_stress, self.max_distortion)
+        warning = atlas.refinement_warning()
+        if warning:
+            ctx.log.warning(warning)
         with ctx.timed("charts"):
             atlas.build_charts(lambda it, **kw: ctx.progress(it, **kw))
         with ctx.timed("quadrature"):

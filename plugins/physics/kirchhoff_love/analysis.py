@@ -84,6 +84,9 @@ def build_model(cloud, settings, atlas_settings, make_embedder, make_lme, make_p
     atlas = Atlas(atlas_settings, make_embedder, make_lme, make_pu)
     with _timed(times, "partition"):
         atlas.partition(nodes, markers)
+    warning = atlas.refinement_warning()
+    if warning and log is not None:
+        log.warning(warning)
     with _timed(times, "charts"):
         atlas.build_charts()
     with _timed(times, "quadrature"):

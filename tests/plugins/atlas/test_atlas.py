@@ -108,3 +108,18 @@ def test_fold_detected_by_embedding_defects():
 def test_bad_settings_raise():
     with pytest.raises(ConfigError, match="gamma_pu"):
         make_atlas(gamma_pu=-1.0).build(np.random.default_rng(0).standard_normal((50, 3)))
+
+
+def test_refinement_warning_names_the_failing_patches_and_the_fixes(atlas):
+    assert atlas.refinement_warning() is None  # the sphere's charts all pass
+    rng = np.random.default_rng(1)
+    t, z = rng.uniform(0, 2 * np.pi, 600), rng.uniform(-2.0, 2.0, 600)
+    thin_pipe = np.column_stack([0.3 * np.cos(t), 0.3 * np.sin(t), z])  # 8 spacings round
+    pipe = make_atlas(markers_per_patch=60, max_refinement_depth=1)
+    pipe.partition(thin_pipe)
+    n_bad = int((~pipe.accepted_).sum())
+    assert n_bad > 0  # PCA of a patch wrapped round the pipe folds
+    message = pipe.refinement_warning()
+    assert message.startswith(f"{n_bad} of {pipe.accepted_.size} patch(es)")
+    for fix in ("more densely", "chart_margin", "gamma_pu", "isomap"):
+        assert fix in message

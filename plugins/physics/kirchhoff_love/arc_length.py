@@ -19,7 +19,9 @@ and δU = δU_R + δλ δU_F with δλ the root of a δλ² + b δλ + c = 0 (a 
 b = 2 δU_F·(ΔU + δU_R), c = |ΔU + δU_R|² − Δs²) that keeps ΔU closest in direction to the
 previous iterate (when there is no real root, the minimiser −b/2a of the quadratic). The
 predictor follows the tangent δU_F with the sign of ΔU_prev·δU_F
-(so the path continues through limit points). Δs adapts to the Newton iterations
+(so the path continues through limit points); an increment that turns back against the
+previous one (the corrector fell onto the states just left) is redone with the predictor
+reversed, then with a shorter arc. Δs adapts to the Newton iterations
 (×sqrt(desired/it), within [½, 2] per increment and at most Δs₀, the length of the first
 increment, which is load controlled; an increment whose |Δλ| exceeds 1.5 nominal steps is
 redone with a proportionally shorter arc); ``path.levels`` (tabulated load factors) are
@@ -51,10 +53,11 @@ def arc_mask(eq, n_dofs: int) -> np.ndarray:
 
 
 def arc_increment(eq, path: PathSettings, U0, mu0, lam0: float, ds: float, dU_prev, m,
-                  log=None, predictor: Optional[np.ndarray] = None):
+                  log=None, predictor: Optional[np.ndarray] = None, reverse: bool = False):
     """One arc-length increment of length ds from the converged (U0, μ0, λ0).
 
-    ``m`` is the :func:`arc_mask`. The predictor is the tangent δU_F (scaled to Δs), or
+    ``m`` is the :func:`arc_mask`. The predictor is the tangent δU_F (scaled to Δs, with the
+    sign of ΔU_prev·δU_F, the opposite one if ``reverse``), or
     ``predictor`` (a direction of unit masked length, with Δλ = 0: the eigenvector
     injection of :mod:`.branch_switching`). Returns (U, μ, λ, iterations, residuals,
     negative pivots) or None if it failed."""
@@ -65,6 +68,7 @@ def arc_increment(eq, path: PathSettings, U0, mu0, lam0: float, ds: float, dU_pr
         if not (np.isfinite(nF) and nF > 0):
             return None
         sign = 1.0 if dU_prev is None or float(dU_prev @ (m * dUF)) >= 0 else -1.0
+        sign = -sign if reverse else sign
         dlam = sign * ds / nF
         DU, Dmu, lam = dlam * dUF, dlam * dmuF, lam0 + dlam
     else:
@@ -104,6 +108,12 @@ def arc_increment(eq, path: PathSettings, U0, mu0, lam0: float, ds: float, dU_pr
         if res <= path.tol:
             return U, mu, lam, it, residuals, confirmed_negative_count(sys)
     return None
+
+
+def turned_back(U_new, U, dU_prev, m) -> bool:
+    """True if the step U → U_new points against the previous increment dU_prev (masked):
+    the path is being retraced instead of followed."""
+    return dU_prev is not None and float(dU_prev @ (m * (U_new - U))) < 0.0
 
 
 def follow_arc_length(eq, path: PathSettings, on_increment=None, log=None,
@@ -154,6 +164,16 @@ def follow_arc_length(eq, path: PathSettings, on_increment=None, log=None,
                 "Raise study.max_increments or use larger steps (fewer study.n_increments).")
         t0 = time.perf_counter()
         result = arc_increment(eq, path, U, mu, lam, ds, dU_prev, mask, log)
+        if result is not None and turned_back(result[0], U, dU_prev, mask):
+            # the corrector went back along the path (near a tight pair of folds the sphere
+            # |ΔU| = Δs also meets the states just left): retry with the predictor reversed,
+            # and if that turns back too, shorten the arc
+            if log is not None:
+                log.warning("arc-length increment from λ = %.5g went back along the path (to "
+                            "λ = %.5g); retrying with the predictor reversed", lam, result[2])
+            result = arc_increment(eq, path, U, mu, lam, ds, dU_prev, mask, log, reverse=True)
+            if result is not None and turned_back(result[0], U, dU_prev, mask):
+                result = None
         if result is None:
             ds *= 0.5
             if log is not None:

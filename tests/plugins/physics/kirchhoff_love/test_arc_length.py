@@ -94,3 +94,31 @@ def test_force_control_jumps_over_the_unstable_branch(monkeypatch):
     lam = [round(i.load_factor, 12) for i in landed]
     assert lam[0] == 0.05 and 0.33 in lam and lam[-1] == 1.0
     assert max(np.diff([0.0, *lam])) <= 0.1 + 1e-12
+
+
+def test_an_increment_that_turns_back_is_redone_not_kept(monkeypatch):
+    """Near a tight pair of folds the corrector can land on the state just left (seen on the
+    connected pipes); such an increment is redone (predictor reversed, then a shorter arc)."""
+    from pointatlas_physics.kirchhoff_love import arc_length as AL
+
+    real, calls = AL.arc_increment, []
+
+    def retracing(eq, path, U0, mu0, lam0, ds, dU_prev, m, log=None, predictor=None,
+                  reverse=False):
+        calls.append(reverse)
+        if len(calls) == 3:  # the third arc increment falls back onto the previous state
+            U = U0 - dU_prev
+            return U, mu0, float(force(U[0])), 3, [1e-12], 0
+        return real(eq, path, U0, mu0, lam0, ds, dU_prev, m, log, predictor, reverse)
+
+    monkeypatch.setattr(AL, "arc_increment", retracing)
+    path = PathSettings(n_increments=10, max_load_factor=1.0, tol=1e-10, max_newton=15)
+    incs = AL.follow_arc_length(CubicSpring(), path)
+    assert calls[2:4] == [False, True]         # the turned-back one, then the reversed retry
+    u = np.array([i.U.ravel()[0] for i in incs])
+    assert np.all(np.diff(u) > 0)              # u grows along this path: nothing retraced
+    assert incs[-1].load_factor == 1.0 and np.allclose(force(u), [i.load_factor for i in incs],
+                                                       atol=1e-9)
+    assert AL.turned_back(np.array([0.0, 0, 0]), np.array([1.0, 0, 0]), np.array([1.0, 0, 0]),
+                          np.ones(3))
+    assert not AL.turned_back(np.array([2.0, 0, 0]), np.array([1.0, 0, 0]), None, np.ones(3))

@@ -10,6 +10,9 @@ load path (:mod:`pointatlas_physics.kirchhoff_love.incremental`) under ``control
   on loads and imposed displacements together, through limit points and snap-backs; with
   ``branch_switching`` it also leaves the path at simple bifurcations for the secondary
   branch (eigenvector injection, :mod:`pointatlas_physics.kirchhoff_love.branch_switching`);
+- under ``force`` or ``displacement`` control with ``stable_path``, an increment that ends on
+  an unstable equilibrium is replaced by the stable one the shell snaps to at that load
+  (:mod:`pointatlas_physics.kirchhoff_love.stable_equilibrium`);
 
 and records, along a dim ``increment``: ``load_factor``, ``load`` (= load_factor × ``full_load``
 under loads),
@@ -48,6 +51,8 @@ class ShellPathSettings(ShellStudySettings):
     max_increments: int = 400           # arc length: increments before giving up
     branch_switching: bool = False      # arc length: leave the path at simple bifurcations
     max_branch_switches: int = 3        # ... at most this many times
+    stable_path: bool = False           # force/displacement control: from an unstable
+                                        # equilibrium, snap to the stable one at that load
     monitor_points: List[float] = field(default_factory=list)       # x, y, z per point
     monitor_directions: List[float] = field(default_factory=list)   # unit vector per point
     monitor_names: List[str] = field(default_factory=list)
@@ -128,6 +133,7 @@ class ShellNonlinearStudy:
                             max_increments=self.max_increments,
                             branch_switching=self.branch_switching,
                             max_branch_switches=self.max_branch_switches,
+                            stable_path=self.stable_path,
                             levels=tuple(self.reference_load_factors))
         self._imposed = [(k, np.asarray(sup.value, float)) for k, sup in enumerate(s.supports)
                          if sup.kind == "displacement"]
@@ -166,6 +172,10 @@ class ShellNonlinearStudy:
         if self.branch_switching and self.control != "arc_length":
             raise ConfigError("study.branch_switching=true needs study.control=arc_length (the "
                               "secondary branch is followed by arc length).")
+        if self.stable_path and self.control == "arc_length":
+            raise ConfigError("study.stable_path=true needs study.control=force or displacement "
+                              "(arc length follows the unstable branches on purpose; use "
+                              "branch_switching there).")
         imposed = any(sup.kind == "displacement" for sup in s.supports)
         if self.control == "displacement":
             if not imposed:

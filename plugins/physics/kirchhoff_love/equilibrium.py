@@ -66,14 +66,17 @@ class Equilibrium:
         c = self.C @ U - lam * self.g
         return W - lam * float(self.F @ U) + float(mu @ c) + 0.5 * (self.rho or 0.0) * float(c @ c)
 
-    def system(self, U):
-        """The factorised constrained tangent K_T(U) + ρCᵀC (:class:`ConstrainedSystem`)."""
+    def system(self, U, shift: float = 0.0):
+        """The factorised constrained tangent K_T(U) + ρCᵀC (:class:`ConstrainedSystem`);
+        ``shift`` σ (force per length) adds σI, a modified Newton step that descends on an
+        indefinite K_T (:mod:`.stable_equilibrium`)."""
         from scipy.sparse import diags
 
         from .nonlinear import tangent_stiffness
         from .solver import ConstrainedSystem
 
-        K = (tangent_stiffness(self.q, self.mat, U.reshape(-1, 3)) + diags(self.springs)).tocsr()
+        K = (tangent_stiffness(self.q, self.mat, U.reshape(-1, 3))
+             + diags(self.springs + shift)).tocsr()
         sys = ConstrainedSystem(K, self.C, self.settings.penalty, self.settings.constraint_tol,
                                 method=self.settings.solver)
         self.rho = sys.rho

@@ -85,6 +85,7 @@ class PathSettings:
     desired_iterations: int = 5   # arc length: Newton iterations the step size aims at
     branch_switching: bool = False  # arc length: leave the path at simple bifurcations
     max_branch_switches: int = 3
+    stable_path: bool = False     # load control: snap from an unstable equilibrium to a stable one
 
 
 def follow_path(model, settings, path: PathSettings, F: np.ndarray, constraints,
@@ -122,6 +123,15 @@ def follow_path(model, settings, path: PathSettings, F: np.ndarray, constraints,
         result = load_increment(eq, path, guess, mu, target, log)
         if result is None and prev is not None:
             result = load_increment(eq, path, U, mu, target, log)
+        snapped = False
+        if result is None and path.stable_path:
+            # past a limit point Newton has nothing near to converge to: the shell snaps
+            from .stable_equilibrium import minimise_to_stable
+
+            if log is not None:
+                log.info("λ = %.5g: Newton did not converge; descending on the energy from "
+                         "the last state (a snap-through?)", target)
+            result, snapped = minimise_to_stable(eq, path, U, mu, target, log), True
         if result is None:
             step = 0.5 * (target - lam_load)
             if log is not None:
@@ -135,7 +145,9 @@ def follow_path(model, settings, path: PathSettings, F: np.ndarray, constraints,
                     "smaller steps (more increments), displacement control, or arc-length "
                     "control (study.control=arc_length).")
             continue
-        prev = (U, target - lam_load)
+        prev = None if snapped else (U, target - lam_load)
+        if path.stable_path and result[4] > 0:
+            result, prev = _snap(eq, path, U, result, target, log), None
         U, mu, it, residuals, negative = result
         lam_load = target
         done.append(make_increment(eq, U, mu, lam_load, it, residuals, negative, t0))
@@ -144,6 +156,28 @@ def follow_path(model, settings, path: PathSettings, F: np.ndarray, constraints,
         if it <= 4:  # converging easily: grow the step back towards its nominal size
             step = min(2 * step, nominal)
     return done
+
+
+def _snap(eq, path, U_before, result, lam: float, log):
+    """``result`` (an unstable equilibrium at λ) replaced by the stable one it snaps to
+    (:func:`.stable_equilibrium.descend_to_stable`); kept, with a warning, if none is found."""
+    from .stable_equilibrium import descend_to_stable, snap_amplitude
+
+    U, mu, it, residuals, negative = result
+    if log is not None:
+        log.info("λ = %.5g: the equilibrium reached has %d negative eigenvalue(s); looking "
+                 "for the stable state it snaps to", lam, negative)
+    snapped = descend_to_stable(eq, path, U, mu, lam, snap_amplitude(U, U_before), log)
+    if snapped is None:
+        if log is not None:
+            log.warning("λ = %.5g: no stable equilibrium found next to the unstable one; the "
+                        "path goes on from the unstable state (use smaller steps or arc-length "
+                        "control)", lam)
+        return result
+    if log is not None:
+        log.info("λ = %.5g: snapped to a stable equilibrium (%d + %d iterations)", lam, it,
+                 snapped[2])
+    return (snapped[0], snapped[1], it + snapped[2], residuals + snapped[3], 0)
 
 
 def make_increment(eq, U, mu, lam, iterations, residuals, negative, t0) -> Increment:

@@ -1,0 +1,92 @@
+"""Quasi-static snaps under load control: the pitchfork of test_branch_switching, whose
+primary path x = λ, y = 0 is unstable past λ = 1 while the branches x = 2λ − 1,
+y² = 2λ − 2 are stable."""
+import numpy as np
+import pytest
+from scipy.sparse import csr_matrix
+
+import pointatlas_physics.kirchhoff_love.equilibrium as equilibrium
+from pointatlas_physics.kirchhoff_love.incremental import PathSettings, follow_path
+from pointatlas_physics.kirchhoff_love.solver import ConstrainedSystem
+from pointatlas_physics.kirchhoff_love.stable_equilibrium import (descend_to_stable,
+                                                                  snap_amplitude)
+
+from .test_branch_switching import Pitchfork
+
+
+class ShiftablePitchfork(Pitchfork):
+    """Adds what the descent needs: Π_ρ and the shifted tangent K_T + σI."""
+
+    def merit(self, W, U, mu, lam):
+        c = self.C @ U - lam * self.g
+        return W - lam * float(self.F @ U) + float(mu @ c) + 0.5 * (self.rho or 0) * float(c @ c)
+
+    def system(self, U, shift: float = 0.0):
+        x, y, _ = U
+        K = np.array([[1.0, -y, 0.0], [-y, 1 - x + 3 * y * y, 0.0], [0, 0, 1.0]])
+        sys = ConstrainedSystem(csr_matrix(K + shift * np.eye(3)), self.C, 1e3, 1e-12)
+        self.rho = sys.rho
+        return sys
+
+
+def run(monkeypatch, stable_path: bool):
+    monkeypatch.setattr(equilibrium, "Equilibrium", lambda *a, **k: ShiftablePitchfork())
+    path = PathSettings(n_increments=7, max_load_factor=2.0, tol=1e-10, max_newton=20,
+                        stable_path=stable_path)
+    return follow_path(None, None, path, None, None)
+
+
+def test_without_stable_path_load_control_stays_on_the_unstable_branch(monkeypatch):
+    incs = run(monkeypatch, False)
+    U = np.array([i.U.ravel() for i in incs])
+    assert np.allclose(U[:, 1], 0.0)
+    assert [i.stable for i in incs] == [i.load_factor < 1.0 for i in incs]
+
+
+def test_stable_path_snaps_onto_the_stable_branch(monkeypatch):
+    incs = run(monkeypatch, True)
+    U = np.array([i.U.ravel() for i in incs])
+    lam = np.array([i.load_factor for i in incs])
+    assert lam[-1] == 2.0 and all(i.stable for i in incs)
+    for i in incs:   # every reported state is an equilibrium
+        R, _ = ShiftablePitchfork().residual(i.U.ravel(), np.zeros(1), i.load_factor)
+        assert np.abs(R).max() < 1e-8
+    past = lam > 1.0
+    assert np.allclose(U[past, 1] ** 2, 2 * lam[past] - 2, atol=1e-8)
+    assert np.allclose(U[past, 0], 2 * lam[past] - 1, atol=1e-8)
+    assert np.allclose(U[~past, 1], 0.0)
+    # one branch throughout (no flip-flopping between y > 0 and y < 0)
+    assert len(set(np.sign(U[past, 1]))) == 1
+
+
+def test_descent_from_the_saddle_lowers_the_energy(monkeypatch):
+    eq = ShiftablePitchfork()
+    lam, U0, mu0 = 1.5, np.array([1.5, 0.0, 0.0]), np.zeros(1)
+    path = PathSettings(tol=1e-12)
+    U, mu, it, residuals, negative = descend_to_stable(eq, path, U0, mu0, lam, 0.1)
+    assert negative == 0 and residuals[-1] <= 1e-12
+    assert U[0] == pytest.approx(2.0) and abs(U[1]) == pytest.approx(1.0)
+    W0, W = eq.residual(U0, mu0, lam)[1], eq.residual(U, mu, lam)[1]
+    assert eq.merit(W, U, mu, lam) < eq.merit(W0, U0, mu0, lam)
+    assert snap_amplitude(U, U0) == pytest.approx(1.0)
+    assert snap_amplitude(U0, U0, floor=0.2) == 0.2
+
+
+def test_past_a_limit_point_the_descent_finds_the_far_stable_branch():
+    """The cubic spring of test_arc_length at λ = 0.3, beyond its limit point λ = 0.201:
+    from the last state before it (u = 0.3) the descent ends on the far branch."""
+    from pointatlas_physics.kirchhoff_love.stable_equilibrium import minimise_to_stable
+
+    from .test_arc_length import CubicSpring, force
+
+    class ShiftableSpring(CubicSpring):
+        def system(self, U, shift: float = 0.0):
+            K = np.diag([1 - 3 * U[0] + 1.8 * U[0] ** 2, 1.0, 1.0]) + shift * np.eye(3)
+            sys = ConstrainedSystem(csr_matrix(K), self.C, 1e3, 1e-12)
+            self.rho = sys.rho
+            return sys
+
+    U, mu, it, residuals, negative = minimise_to_stable(
+        ShiftableSpring(), PathSettings(tol=1e-12), np.array([0.3, 0.0, 0.0]), np.zeros(2), 0.3)
+    upper = (3 + np.sqrt(1.8)) / 3.6
+    assert negative == 0 and U[0] > upper and force(U[0]) == pytest.approx(0.3, abs=1e-10)

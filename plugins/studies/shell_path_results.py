@@ -60,6 +60,9 @@ def path_dataset(study, dof: int, points, records, values, names, fields, loads)
                                                      np.int32), {
             **ONE, "long_name": "negative pivots of the factorised constrained tangent "
                                 "(-1: not computed)"}),
+        "snapped": (("increment",), np.array([r.snapped for r in records], np.int8), {
+            **ONE, "long_name": "1 if the increment ended by a snap to a stable state "
+                                "(study.stable_path)"}),
         "increment_time": (("increment",), secs, {"long_name": "wall time of the increment",
                                                   "units": "s"}),
         "time_per_newton_iteration": ((), float(secs.sum() / its.sum()) if its.sum() else

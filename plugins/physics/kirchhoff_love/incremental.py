@@ -67,6 +67,7 @@ class Increment:
     stable: bool
     seconds: float
     reactions: Optional[np.ndarray] = None   # (n_supports, 3) resultant reaction forces
+    snapped: bool = False         # reached by a snap to a stable state (stable_path)
 
 
 @dataclass
@@ -147,10 +148,12 @@ def follow_path(model, settings, path: PathSettings, F: np.ndarray, constraints,
             continue
         prev = None if snapped else (U, target - lam_load)
         if path.stable_path and result[4] > 0:
-            result, prev = _snap(eq, path, U, result, target, log), None
+            result, snapped = _snap(eq, path, U, result, target, log)
+            prev = None
         U, mu, it, residuals, negative = result
         lam_load = target
         done.append(make_increment(eq, U, mu, lam_load, it, residuals, negative, t0))
+        done[-1].snapped = snapped
         if on_increment is not None:
             on_increment(done[-1])
         if it <= 4:  # converging easily: grow the step back towards its nominal size
@@ -159,8 +162,9 @@ def follow_path(model, settings, path: PathSettings, F: np.ndarray, constraints,
 
 
 def _snap(eq, path, U_before, result, lam: float, log):
-    """``result`` (an unstable equilibrium at λ) replaced by the stable one it snaps to
-    (:func:`.stable_equilibrium.descend_to_stable`); kept, with a warning, if none is found."""
+    """(result, True) with ``result`` (an unstable equilibrium at λ) replaced by the stable
+    one it snaps to (:func:`.stable_equilibrium.descend_to_stable`); (result, False), with a
+    warning, if none is found."""
     from .stable_equilibrium import descend_to_stable, snap_amplitude
 
     U, mu, it, residuals, negative = result
@@ -173,11 +177,11 @@ def _snap(eq, path, U_before, result, lam: float, log):
             log.warning("λ = %.5g: no stable equilibrium found next to the unstable one; the "
                         "path goes on from the unstable state (use smaller steps or arc-length "
                         "control)", lam)
-        return result
+        return result, False
     if log is not None:
         log.info("λ = %.5g: snapped to a stable equilibrium (%d + %d iterations)", lam, it,
                  snapped[2])
-    return (snapped[0], snapped[1], it + snapped[2], residuals + snapped[3], 0)
+    return (snapped[0], snapped[1], it + snapped[2], residuals + snapped[3], 0), True
 
 
 def make_increment(eq, U, mu, lam, iterations, residuals, negative, t0) -> Increment:

@@ -61,8 +61,6 @@ def minimise_to_stable(eq, path, U: np.ndarray, mu: np.ndarray, lam: float, log=
     equilibrium: (U, μ, iterations, residuals, 0), or None. Also what follows the path past
     a limit point of the control, where plain Newton from the last state has nothing to
     converge to and the shell snaps."""
-    from .incremental import _line_search
-
     U, mu = U.copy(), mu.copy()
     R, W = eq.residual(U, mu, lam)
     residuals = []
@@ -78,10 +76,11 @@ def minimise_to_stable(eq, path, U: np.ndarray, mu: np.ndarray, lam: float, log=
         dU, dmu, _ = system.solve(-R, lam * eq.g - eq.C @ U)
         if not np.all(np.isfinite(dU)):
             return None
-        R_new, W_new = eq.residual(U + dU, mu + dmu, lam)
-        alpha, R_new, W_new = _line_search(eq, U, mu, dmu, lam, dU, R, W, R_new, W_new,
-                                           max_cuts=8)
-        U, mu, R, W = U + alpha * dU, mu + dmu, R_new, W_new
+        step = _armijo(eq, U, mu, dmu, lam, dU, R, W)
+        if step is None:
+            return None     # no decrease of Π_ρ along dU: stuck
+        alpha, R, W = step
+        U, mu = U + alpha * dU, mu + dmu
         res = float(np.linalg.norm(R)) / eq.scale(lam, mu)
         residuals.append(res)
         if log is not None:
@@ -93,6 +92,26 @@ def minimise_to_stable(eq, path, U: np.ndarray, mu: np.ndarray, lam: float, log=
             count = confirmed_negative_count(eq.system(U))
             if count == 0:
                 return U, mu, it, residuals, 0
+    return None
+
+
+def _armijo(eq, U, mu_old, dmu, lam: float, dU, R, W, c1: float = 1e-4, max_cuts: int = 12):
+    """Backtracking on Π_ρ(U + α dU; μ_old + dμ, λ) until the Armijo decrease holds (a pure
+    energy criterion: a descent must not accept a step because |R| happens to fall):
+    (α, R, W) at the accepted α, or None if no α ≥ 2^-max_cuts decreases Π_ρ."""
+    mu = mu_old + dmu
+    c = eq.C @ U - lam * eq.g
+    grad = R + eq.C.T @ (dmu + (eq.rho or 0.0) * c)     # ∇Π_ρ(U; μ, λ)
+    slope = float(grad @ dU)
+    phi0 = eq.merit(W, U, mu, lam)
+    if not slope < 0:
+        return None
+    alpha = 1.0
+    for _ in range(max_cuts + 1):
+        R_a, W_a = eq.residual(U + alpha * dU, mu, lam)
+        if eq.merit(W_a, U + alpha * dU, mu, lam) <= phi0 + c1 * alpha * slope:
+            return alpha, R_a, W_a
+        alpha *= 0.5
     return None
 
 

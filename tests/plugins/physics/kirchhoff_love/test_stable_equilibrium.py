@@ -90,3 +90,10 @@ def test_past_a_limit_point_the_descent_finds_the_far_stable_branch():
         ShiftableSpring(), PathSettings(tol=1e-12), np.array([0.3, 0.0, 0.0]), np.zeros(2), 0.3)
     upper = (3 + np.sqrt(1.8)) / 3.6
     assert negative == 0 and U[0] > upper and force(U[0]) == pytest.approx(0.3, abs=1e-10)
+
+
+def test_snapped_increments_are_flagged(monkeypatch):
+    incs = run(monkeypatch, True)
+    # only the first increment past λ = 1 snaps; Newton then follows the secondary branch
+    first = next(k for k, i in enumerate(incs) if i.load_factor > 1.0)
+    assert [i.snapped for i in incs] == [k == first for k in range(len(incs))]

@@ -39,6 +39,8 @@ import numpy as np
 
 from pointatlas.errors import PointatlasError
 
+from .stable_equilibrium import minimise_to_stable, snap_amplitude
+
 
 def support_reactions(C, mu: np.ndarray, row_support: np.ndarray) -> np.ndarray:
     """Resultant force (n_supports, 3) each support exerts on the shell, −Σ rows Cᵀμ."""
@@ -121,18 +123,17 @@ def follow_path(model, settings, path: PathSettings, F: np.ndarray, constraints,
         t0 = time.perf_counter()
         # secant predictor: extrapolate the last converged increment to the new load
         guess = U if prev is None else U + ((target - lam_load) / prev[1]) * (U - prev[0])
-        result = load_increment(eq, path, guess, mu, target, log)
-        if result is None and prev is not None:
-            result = load_increment(eq, path, U, mu, target, log)
         snapped = False
-        if result is None and path.stable_path:
-            # past a limit point Newton has nothing near to converge to: the shell snaps
-            from .stable_equilibrium import minimise_to_stable
-
-            if log is not None:
-                log.info("λ = %.5g: Newton did not converge; descending on the energy from "
-                         "the last state (a snap-through?)", target)
-            result, snapped = minimise_to_stable(eq, path, U, mu, target, log), True
+        if path.stable_path:
+            # descent on Π: stable states only; past a limit point, the one the shell snaps to
+            result = minimise_to_stable(eq, path, guess, mu, target, log, 4 * path.max_newton,
+                                        snap_amplitude(guess, U, floor=1e-3 * _size(eq)))
+            if result is not None:
+                *result, snapped = result
+        else:
+            result = load_increment(eq, path, guess, mu, target, log)
+            if result is None and prev is not None:
+                result = load_increment(eq, path, U, mu, target, log)
         if result is None:
             step = 0.5 * (target - lam_load)
             if log is not None:
@@ -147,9 +148,6 @@ def follow_path(model, settings, path: PathSettings, F: np.ndarray, constraints,
                     "control (study.control=arc_length).")
             continue
         prev = None if snapped else (U, target - lam_load)
-        if path.stable_path and result[4] > 0:
-            result, snapped = _snap(eq, path, U, result, target, log)
-            prev = None
         U, mu, it, residuals, negative = result
         lam_load = target
         done.append(make_increment(eq, U, mu, lam_load, it, residuals, negative, t0))
@@ -161,27 +159,10 @@ def follow_path(model, settings, path: PathSettings, F: np.ndarray, constraints,
     return done
 
 
-def _snap(eq, path, U_before, result, lam: float, log):
-    """(result, True) with ``result`` (an unstable equilibrium at λ) replaced by the stable
-    one it snaps to (:func:`.stable_equilibrium.descend_to_stable`); (result, False), with a
-    warning, if none is found."""
-    from .stable_equilibrium import descend_to_stable, snap_amplitude
-
-    U, mu, it, residuals, negative = result
-    if log is not None:
-        log.info("λ = %.5g: the equilibrium reached has %d negative eigenvalue(s); looking "
-                 "for the stable state it snaps to", lam, negative)
-    snapped = descend_to_stable(eq, path, U, mu, lam, snap_amplitude(U, U_before), log)
-    if snapped is None:
-        if log is not None:
-            log.warning("λ = %.5g: no stable equilibrium found next to the unstable one; the "
-                        "path goes on from the unstable state (use smaller steps or arc-length "
-                        "control)", lam)
-        return result, False
-    if log is not None:
-        log.info("λ = %.5g: snapped to a stable equilibrium (%d + %d iterations)", lam, it,
-                 snapped[2])
-    return (snapped[0], snapped[1], it + snapped[2], residuals + snapped[3], 0), True
+def _size(eq) -> float:
+    """Size of the shell (length): the largest extent of its nodes, 1 without a model."""
+    model = getattr(eq, "model", None)
+    return 1.0 if model is None else float(np.ptp(model.nodes, axis=0).max())
 
 
 def make_increment(eq, U, mu, lam, iterations, residuals, negative, t0) -> Increment:

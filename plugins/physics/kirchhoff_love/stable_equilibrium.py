@@ -8,15 +8,15 @@ the path follows it instead of the unstable branch (the quasi-static analogue of
 thesis' post-buckling runs, Paper 2 §5.5–5.6, where the imposed displacement grows and the
 shell "undergoes several geometric instabilities").
 
-The snap is found by descent on the augmented Lagrangian Π_ρ: perturb the saddle along its
-most unstable eigenvector (shift-invert Lanczos, :func:`.branch_switching.negative_modes`),
-then take Newton steps on the shifted tangent K_T + σI while K_T is indefinite, with σ
-twice the magnitude of its most negative eigenvalue (a Levenberg–Marquardt-type modified
-Newton step is a descent direction, Nocedal & Wright 2006 §3.4), with an Armijo line search;
-once K_T is positive definite, plain Newton converges quadratically to the stable minimum.
-Both signs of the perturbation are tried; the stable end state of lower Π is kept. Past a
-limit point of the control, where plain Newton finds no equilibrium near the last state,
-the same descent from that state (:func:`minimise_to_stable`) finds the one it snaps to.
+With ``stable_path`` every increment is solved by descent on the augmented Lagrangian Π_ρ
+(:func:`minimise_to_stable`): Newton steps with an Armijo line search on Π_ρ, on the shifted
+tangent K_T + σI while K_T is indefinite (σ twice the magnitude of its most negative
+eigenvalue, by shift-invert Lanczos, :func:`.branch_switching.negative_modes`; a
+Levenberg–Marquardt-type modified Newton step is a descent direction, Nocedal & Wright 2006
+§3.4). Near a stable solution this is plain Newton (full steps, quadratic convergence); past
+a limit point, where plain Newton from the last state has nothing near to converge to, it
+descends to the state the shell snaps to; a state that converges onto a saddle (a symmetric
+path past a bifurcation) is pushed off along its unstable mode.
 """
 from __future__ import annotations
 
@@ -26,72 +26,70 @@ import numpy as np
 
 from .branch_switching import confirmed_negative_count, negative_modes
 
-
-def descend_to_stable(eq, path, U0: np.ndarray, mu0: np.ndarray, lam: float,
-                      amplitude: float, log=None, max_iter: int = 60):
-    """A stable equilibrium at load factor λ near the unstable one (U0, μ0).
-
-    ``amplitude`` (length) is the largest nodal displacement of the initial perturbation
-    along the unstable mode, e.g. the size of the increment that reached U0. Returns
-    (U, μ, iterations, residuals, 0) like :func:`.incremental.load_increment`, or None when
-    neither direction reaches a stable equilibrium in ``max_iter`` iterations."""
-    system = eq.system(U0)
-    vals, vecs = negative_modes(system, max(confirmed_negative_count(system), 1))
-    if vals.size == 0:
-        return None
-    phi = vecs[:, 0] / float(np.abs(vecs[:, 0]).max())
-    best, best_energy = None, np.inf
-    for sign in (1.0, -1.0):
-        result = minimise_to_stable(eq, path, U0 + sign * amplitude * phi, mu0, lam, log, max_iter)
-        if result is None:
-            continue
-        W = eq.residual(result[0], result[1], lam)[1]
-        energy = eq.merit(W, result[0], result[1], lam)
-        if log is not None:
-            log.info("  snap (perturbation %+g × mode): stable at Π = %.6g after %d "
-                     "iterations", sign, energy, result[2])
-        if energy < best_energy:
-            best, best_energy = result, energy
-    return best
+#: Relative residual below which a positive-definite tangent takes full Newton steps.
+NEWTON_ZONE = 1e-3
 
 
 def minimise_to_stable(eq, path, U: np.ndarray, mu: np.ndarray, lam: float, log=None,
-                       max_iter: int = 60):
-    """Modified Newton with line search on Π_ρ at load factor λ from U until a stable
-    equilibrium: (U, μ, iterations, residuals, 0), or None. Also what follows the path past
-    a limit point of the control, where plain Newton from the last state has nothing to
-    converge to and the shell snaps."""
+                       max_iter: int = 60, amplitude: float = 0.0):
+    """A stable equilibrium at load factor λ, by descent on Π_ρ from U: Newton steps (on
+    K_T + σI while K_T is indefinite) with an Armijo line search; a state that converges
+    onto a saddle (e.g. a symmetric path past a pitchfork) is left along its most unstable
+    mode with nodal amplitude ``amplitude`` (length; at most twice).
+
+    Returns (U, μ, iterations, residuals, 0, snapped) or None (no stable equilibrium within
+    ``max_iter`` factorisations, or no descent possible). ``snapped``: reaching it needed
+    more than plain Newton (a step cut by the line search, an indefinite tangent or a kick
+    off a saddle), which past a limit point or a bifurcation is the shell snapping."""
     U, mu = U.copy(), mu.copy()
     R, W = eq.residual(U, mu, lam)
-    residuals = []
+    residuals, snapped, kicks = [], False, 0
+    res = float(np.linalg.norm(R)) / eq.scale(lam, mu)
     for it in range(1, max_iter + 1):
         system = eq.system(U)
         negative = confirmed_negative_count(system)
+        if res <= path.tol and negative == 0:
+            return U, mu, it - 1, residuals, 0, snapped
         shift = 0.0
         if negative != 0:
-            vals, _ = negative_modes(system, max(negative, 1))
-            shift = 2.0 * float(-vals[0]) if vals.size else 0.0
-            if shift > 0.0:
+            vals, vecs = negative_modes(system, max(negative, 1))
+            if vals.size:
+                snapped = True
+                if res <= path.tol:
+                    if amplitude <= 0 or kicks == 2:
+                        return None   # a saddle, and no way off it
+                    U = U + amplitude * vecs[:, 0] / float(np.abs(vecs[:, 0]).max())
+                    R, W = eq.residual(U, mu, lam)
+                    res, kicks = np.inf, kicks + 1
+                    if log is not None:
+                        log.info("  λ = %.5g: converged onto a saddle (%d negative "
+                                 "eigenvalue(s)); leaving it along the unstable mode", lam,
+                                 vals.size)
+                    continue
+                shift = 2.0 * float(-vals[0])
                 system = eq.system(U, shift=shift)
         dU, dmu, _ = system.solve(-R, lam * eq.g - eq.C @ U)
         if not np.all(np.isfinite(dU)):
             return None
-        step = _armijo(eq, U, mu, dmu, lam, dU, R, W)
-        if step is None:
-            return None     # no decrease of Π_ρ along dU: stuck
-        alpha, R, W = step
+        if shift == 0.0 and res <= NEWTON_ZONE:
+            # close to a stable state: full Newton steps (the energy change is at round-off
+            # level there, so an energy test would only cut good steps)
+            alpha, (R, W) = 1.0, eq.residual(U + dU, mu + dmu, lam)
+        else:
+            step = _armijo(eq, U, mu, dmu, lam, dU, R, W)
+            if step is None:
+                return None     # no decrease of Π_ρ along dU: stuck
+            alpha, R, W = step
+        snapped = snapped or alpha < 1.0
         U, mu = U + alpha * dU, mu + dmu
         res = float(np.linalg.norm(R)) / eq.scale(lam, mu)
         residuals.append(res)
         if log is not None:
-            log.info("  snap: λ = %.5g  iteration %d: |R|/|λF| = %.3e  shift %.3g  step %.3g",
-                     lam, it, res, shift, alpha)
+            log.info("  λ = %.5g  descent %d: |R|/|λF| = %.3e  |ΔU| = %.3e%s%s", lam, it, res,
+                     float(np.abs(alpha * dU).max()), "" if alpha == 1.0 else
+                     f"  (step {alpha:.3g})", "" if shift == 0.0 else f"  (shift {shift:.3g})")
         if not np.isfinite(res):
             return None
-        if res <= path.tol and shift == 0.0:
-            count = confirmed_negative_count(eq.system(U))
-            if count == 0:
-                return U, mu, it, residuals, 0
     return None
 
 

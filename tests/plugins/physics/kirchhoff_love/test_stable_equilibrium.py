@@ -8,7 +8,7 @@ from scipy.sparse import csr_matrix
 import pointatlas_physics.kirchhoff_love.equilibrium as equilibrium
 from pointatlas_physics.kirchhoff_love.incremental import PathSettings, follow_path
 from pointatlas_physics.kirchhoff_love.solver import ConstrainedSystem
-from pointatlas_physics.kirchhoff_love.stable_equilibrium import (descend_to_stable,
+from pointatlas_physics.kirchhoff_love.stable_equilibrium import (minimise_to_stable,
                                                                   snap_amplitude)
 
 from .test_branch_switching import Pitchfork
@@ -59,17 +59,22 @@ def test_stable_path_snaps_onto_the_stable_branch(monkeypatch):
     assert len(set(np.sign(U[past, 1]))) == 1
 
 
-def test_descent_from_the_saddle_lowers_the_energy(monkeypatch):
+def test_descent_leaves_a_saddle_along_its_unstable_mode_and_lowers_the_energy():
     eq = ShiftablePitchfork()
-    lam, U0, mu0 = 1.5, np.array([1.5, 0.0, 0.0]), np.zeros(1)
+    lam, U0, mu0 = 1.5, np.array([1.5, 0.0, 0.0]), np.zeros(1)   # the saddle x = λ, y = 0
     path = PathSettings(tol=1e-12)
-    U, mu, it, residuals, negative = descend_to_stable(eq, path, U0, mu0, lam, 0.1)
-    assert negative == 0 and residuals[-1] <= 1e-12
+    assert minimise_to_stable(eq, path, U0, mu0, lam) is None   # no way off it without a kick
+    U, mu, it, residuals, negative, snapped = minimise_to_stable(eq, path, U0, mu0, lam,
+                                                                 amplitude=0.1)
+    assert negative == 0 and snapped and residuals[-1] <= 1e-12
     assert U[0] == pytest.approx(2.0) and abs(U[1]) == pytest.approx(1.0)
     W0, W = eq.residual(U0, mu0, lam)[1], eq.residual(U, mu, lam)[1]
     assert eq.merit(W, U, mu, lam) < eq.merit(W0, U0, mu0, lam)
     assert snap_amplitude(U, U0) == pytest.approx(1.0)
     assert snap_amplitude(U0, U0, floor=0.2) == 0.2
+    # from a point near a stable state it is plain Newton: full steps, no snap
+    U1, *_, snapped1 = minimise_to_stable(eq, path, U + 1e-3, mu, lam)
+    assert not snapped1 and np.allclose(U1, U)
 
 
 def test_past_a_limit_point_the_descent_finds_the_far_stable_branch():
@@ -86,10 +91,11 @@ def test_past_a_limit_point_the_descent_finds_the_far_stable_branch():
             self.rho = sys.rho
             return sys
 
-    U, mu, it, residuals, negative = minimise_to_stable(
+    U, mu, it, residuals, negative, snapped = minimise_to_stable(
         ShiftableSpring(), PathSettings(tol=1e-12), np.array([0.3, 0.0, 0.0]), np.zeros(2), 0.3)
     upper = (3 + np.sqrt(1.8)) / 3.6
-    assert negative == 0 and U[0] > upper and force(U[0]) == pytest.approx(0.3, abs=1e-10)
+    assert negative == 0 and snapped and U[0] > upper
+    assert force(U[0]) == pytest.approx(0.3, abs=1e-10)
 
 
 def test_snapped_increments_are_flagged(monkeypatch):

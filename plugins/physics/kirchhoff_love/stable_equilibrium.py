@@ -44,7 +44,10 @@ def minimise_to_stable(eq, path, U: np.ndarray, mu: np.ndarray, lam: float, log=
     U, mu = U.copy(), mu.copy()
     R, W = eq.residual(U, mu, lam)
     residuals, snapped, kicks = [], False, 0
-    res = float(np.linalg.norm(R)) / eq.scale(lam, mu)
+    # converged only if the supports hold too (an imposed displacement starts violated)
+    violation = float(np.abs(eq.C @ U - lam * eq.g).max(initial=0.0))
+    res = (float(np.linalg.norm(R)) / eq.scale(lam, mu)
+           if violation <= 1e-12 * max(float(np.abs(U).max(initial=0.0)), 1e-300) else np.inf)
     for it in range(1, max_iter + 1):
         system = eq.system(U)
         negative = confirmed_negative_count(system)
@@ -103,6 +106,10 @@ def _armijo(eq, U, mu_old, dmu, lam: float, dU, R, W, c1: float = 1e-4, max_cuts
     slope = float(grad @ dU)
     phi0 = eq.merit(W, U, mu, lam)
     if not slope < 0:
+        if float(np.abs(dU).max(initial=0.0)) <= 1e-14 * max(float(np.abs(U).max(initial=0.0)),
+                                                              1e-300):
+            # nothing moves (the supports fix the step): only the multiplier changes
+            return (1.0, *eq.residual(U + dU, mu, lam))
         return None
     alpha = 1.0
     for _ in range(max_cuts + 1):

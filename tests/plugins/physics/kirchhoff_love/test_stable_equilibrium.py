@@ -103,3 +103,28 @@ def test_snapped_increments_are_flagged(monkeypatch):
     # only the first increment past λ = 1 snaps; Newton then follows the secondary branch
     first = next(k for k, i in enumerate(incs) if i.load_factor > 1.0)
     assert [i.snapped for i in incs] == [k == first for k in range(len(incs))]
+
+
+def test_an_imposed_displacement_is_applied_before_convergence_is_declared():
+    """Displacement control from rest: R = 0 there, but the support is violated."""
+    from .test_arc_length import CubicSpring, force
+
+    class ImposedSpring(CubicSpring):
+        def __init__(self):
+            super().__init__()
+            self.F = np.zeros(3)
+            self.C = csr_matrix(np.eye(3))
+            self.g = np.array([1.0, 0.0, 0.0])      # u = λ, v = w = 0
+
+        merit = ShiftablePitchfork.merit             # Π_ρ with the constraint terms
+
+        def system(self, U, shift: float = 0.0):
+            K = np.diag([1 - 3 * U[0] + 1.8 * U[0] ** 2, 1.0, 1.0]) + shift * np.eye(3)
+            sys = ConstrainedSystem(csr_matrix(K), self.C, 1e3, 1e-12)
+            self.rho = sys.rho
+            return sys
+
+    U, mu, it, *_ = minimise_to_stable(ImposedSpring(), PathSettings(tol=1e-10), np.zeros(3),
+                                       np.zeros(3), 0.3)
+    assert it >= 1 and U[0] == pytest.approx(0.3, abs=1e-12)
+    assert -mu[0] == pytest.approx(force(0.3), rel=1e-8)   # the reaction holds the spring

@@ -10,9 +10,10 @@ load path (:mod:`pointatlas_physics.kirchhoff_love.incremental`) under ``control
   on loads and imposed displacements together, through limit points and snap-backs; with
   ``branch_switching`` it also leaves the path at simple bifurcations for the secondary
   branch (eigenvector injection, :mod:`pointatlas_physics.kirchhoff_love.branch_switching`);
-- under ``force`` or ``displacement`` control with ``stable_path``, an increment that ends on
-  an unstable equilibrium is replaced by the stable one the shell snaps to at that load
-  (:mod:`pointatlas_physics.kirchhoff_love.stable_equilibrium`);
+- under ``force`` or ``displacement`` control with ``stable_path``, every increment is solved
+  by descent on the energy, so it ends on a stable state: past a limit point or a
+  bifurcation, the one the shell snaps to (``snapped``;
+  :mod:`pointatlas_physics.kirchhoff_love.stable_equilibrium`);
 
 and records, along a dim ``increment``: ``load_factor``, ``load`` (= load_factor × ``full_load``
 under loads),
@@ -51,8 +52,8 @@ class ShellPathSettings(ShellStudySettings):
     max_increments: int = 400           # arc length: increments before giving up
     branch_switching: bool = False      # arc length: leave the path at simple bifurcations
     max_branch_switches: int = 3        # ... at most this many times
-    stable_path: bool = False           # force/displacement control: from an unstable
-                                        # equilibrium, snap to the stable one at that load
+    stable_path: bool = False           # force/displacement control by descent on the
+                                        # energy: stable states only, snaps past instabilities
     monitor_points: List[float] = field(default_factory=list)       # x, y, z per point
     monitor_directions: List[float] = field(default_factory=list)   # unit vector per point
     monitor_names: List[str] = field(default_factory=list)

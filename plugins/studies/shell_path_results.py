@@ -61,8 +61,9 @@ def path_dataset(study, dof: int, points, records, values, names, fields, loads)
             **ONE, "long_name": "negative pivots of the factorised constrained tangent "
                                 "(-1: not computed)"}),
         "snapped": (("increment",), np.array([r.snapped for r in records], np.int8), {
-            **ONE, "long_name": "1 if the increment ended by a snap to a stable state "
-                                "(study.stable_path)"}),
+            **ONE, "long_name": "1 if reaching it needed more than plain Newton (a step cut "
+                                "by the energy line search, an indefinite tangent or a kick off "
+                                "a saddle): a snap (study.stable_path)"}),
         "increment_time": (("increment",), secs, {"long_name": "wall time of the increment",
                                                   "units": "s"}),
         "time_per_newton_iteration": ((), float(secs.sum() / its.sum()) if its.sum() else

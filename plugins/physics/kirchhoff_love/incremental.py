@@ -20,6 +20,11 @@ energy backtracking cut the first steps to α = 1/8 and the increment did not co
 200 L-BFGS iterations left |∇Π_ρ| at ~1e5 × the load (the membrane/bending stiffness ratio
 (R/h)² defeats first-order methods without a preconditioner).
 
+With ``stable_path`` each load-controlled increment is solved by descent on Π_ρ instead
+(:func:`.stable_equilibrium.minimise_to_stable`: Newton with an energy line search, on a
+shifted tangent where it is indefinite), so every reported state is stable; past a limit
+point or a bifurcation it is the state the shell snaps to (``Increment.snapped``).
+
 ``control='arc_length'`` follows the path by Crisfield's cylindrical arc length instead
 (:mod:`.arc_length`), passing limit points and snap-backs. A step that does not converge in
 ``max_newton`` iterations (or produces NaN) is cut in half and retried from the last
@@ -88,7 +93,7 @@ class PathSettings:
     desired_iterations: int = 5   # arc length: Newton iterations the step size aims at
     branch_switching: bool = False  # arc length: leave the path at simple bifurcations
     max_branch_switches: int = 3
-    stable_path: bool = False     # load control: snap from an unstable equilibrium to a stable one
+    stable_path: bool = False     # load control by descent on Π: stable states only (snaps)
 
 
 def follow_path(model, settings, path: PathSettings, F: np.ndarray, constraints,

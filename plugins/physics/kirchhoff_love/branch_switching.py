@@ -25,7 +25,8 @@ from typing import Optional
 import numpy as np
 
 
-def negative_modes(system, count: int, tol: float = 1e-8, max_iter: int = 100):
+def negative_modes(system, count: int, tol: float = 1e-8, max_iter: int = 100,
+                   return_nearest: bool = False):
     """(eigenvalues, vectors) of the factorised K_T + ρCᵀC (:class:`.solver.ConstrainedSystem`)
     that are negative, most negative first, by shift-invert Lanczos (scipy ``eigsh``, σ = 0)
     reusing the factorisation: one back-substitution per step. Units: force per length.
@@ -34,14 +35,16 @@ def negative_modes(system, count: int, tol: float = 1e-8, max_iter: int = 100):
     just crossed has its eigenvalue there); if none of them is negative, the most negative
     shifted values 1/λ, i.e. the negative eigenvalues nearest 0 beyond the weakly held
     (ghost) DOFs' cluster of small positive ones. That search converges quickly to an
-    isolated negative eigenvalue; when it does not converge in ``max_iter`` steps there is
-    none to isolate, and no negative eigenvalue is returned."""
+    isolated negative eigenvalue, but behind a dense cluster of tiny positive ones it may
+    not converge in ``max_iter`` steps (then no negative eigenvalue is returned, and
+    :func:`confirmed_negative_count` falls back on the inertia). With ``return_nearest`` the
+    eigenvalues of the first stage are returned too, as a third item."""
     from scipy.sparse.linalg import ArpackNoConvergence, LinearOperator, eigsh
 
     A = system.matrix
     n = A.shape[0]
     inverse = LinearOperator(A.shape, matvec=system.inverse, dtype=float)
-    vals, vecs = np.zeros(0), np.zeros((n, 0))
+    vals, vecs, nearest = np.zeros(0), np.zeros((n, 0)), np.zeros(0)
     for which, k in (("LM", max(count, 1) + 6), ("SA", max(count, 1))):
         k = int(min(k, n - 2))
         if k < 1:
@@ -51,11 +54,15 @@ def negative_modes(system, count: int, tol: float = 1e-8, max_iter: int = 100):
                                maxiter=max_iter)
         except ArpackNoConvergence as exc:
             vals, vecs = exc.eigenvalues, exc.eigenvectors
+        if which == "LM":
+            nearest = vals
         if np.any(vals < 0):
             break
     order = np.argsort(vals)
     vals, vecs = vals[order], vecs[:, order]
     keep = vals < 0
+    if return_nearest:
+        return vals[keep], vecs[:, keep], nearest
     return vals[keep], vecs[:, keep]
 
 
@@ -69,16 +76,15 @@ def confirmed_negative_count(system, max_modes: int = 6) -> int:
     negative eigenvalue may still hide beyond a cluster of tiny positive (ghost) ones, where
     Lanczos converges slowly (the pull-out cylinder: λ = −0.63 behind ~2e-5 ghost modes):
     Sylvester's law of inertia decides, with the pivots of K_ρ + τI, τ ten times the largest
-    of the n + 6 eigenvalues nearest 0 (a shift that lifts round-off-level eigenvalues clear
+    of the eigenvalues nearest 0 that Lanczos saw first (a shift that lifts round-off-level eigenvalues clear
     of 0 and keeps a real instability negative). The pivot count is kept if ARPACK fails."""
     count = getattr(system, "negative_pivots", -1)
     if count <= 0:
         return count
     try:
-        vals, _ = negative_modes(system, min(count, max_modes))
+        vals, _, near = negative_modes(system, min(count, max_modes), return_nearest=True)
         if vals.size:
             return count if vals.size >= min(count, max_modes) else int(vals.size)
-        near = _nearest_zero(system, count + 6)
     except Exception:   # ARPACK failure: keep the pivot count
         return count
     from scipy.sparse import identity
@@ -88,22 +94,6 @@ def confirmed_negative_count(system, max_modes: int = 6) -> int:
     tau = 10.0 * float(np.abs(near).max()) if near.size else 0.0
     shifted = factorize((system.matrix + tau * identity(system.matrix.shape[0])).tocsr())
     return int(getattr(shifted, "negative_pivots", count))
-
-
-def _nearest_zero(system, k: int) -> np.ndarray:
-    """The k eigenvalues of the factorised K_ρ nearest 0 (shift-invert Lanczos, σ = 0)."""
-    from scipy.sparse.linalg import ArpackNoConvergence, LinearOperator, eigsh
-
-    A = system.matrix
-    k = int(min(k, A.shape[0] - 2))
-    if k < 1:
-        return np.zeros(0)
-    inverse = LinearOperator(A.shape, matvec=system.inverse, dtype=float)
-    try:
-        return eigsh(A, k=k, sigma=0.0, which="LM", OPinv=inverse, tol=1e-8, maxiter=100,
-                     return_eigenvectors=False)
-    except ArpackNoConvergence as exc:
-        return exc.eigenvalues
 
 
 def bifurcation_mode(system, step: np.ndarray, mask: np.ndarray, max_cosine: float = 0.95,

@@ -44,7 +44,7 @@ import numpy as np
 
 from pointatlas.errors import PointatlasError
 
-from .stable_equilibrium import minimise_to_stable, snap_amplitude
+from .stable_equilibrium import armijo_step, minimise_to_stable, snap_amplitude
 
 
 def support_reactions(C, mu: np.ndarray, row_support: np.ndarray) -> np.ndarray:
@@ -218,17 +218,5 @@ def _line_search(eq, U, mu_old, dmu, lam, dU, R, W, R_new, W_new, c1: float = 1e
     when dU is not a descent direction (an unstable state) or when no cut decreases Π_ρ."""
     if float(np.linalg.norm(R_new)) < float(np.linalg.norm(R)):
         return 1.0, R_new, W_new   # the full step already reduces the out-of-balance force
-    mu = mu_old + dmu
-    c = eq.C @ U - lam * eq.g
-    grad = R + eq.C.T @ (dmu + (eq.rho or 0.0) * c)     # ∇Π_ρ(U; μ, λ)
-    slope = float(grad @ dU)
-    if not slope < 0:
-        return 1.0, R_new, W_new
-    phi0 = eq.merit(W, U, mu, lam)
-    alpha, R_a, W_a = 1.0, R_new, W_new
-    for _ in range(max_cuts + 1):
-        if eq.merit(W_a, U + alpha * dU, mu, lam) <= phi0 + c1 * alpha * slope:
-            return alpha, R_a, W_a
-        alpha *= 0.5
-        R_a, W_a = eq.residual(U + alpha * dU, mu, lam)
-    return 1.0, R_new, W_new
+    step = armijo_step(eq, U, mu_old, dmu, lam, dU, R, W, c1, max_cuts, full=(R_new, W_new))
+    return (1.0, R_new, W_new) if step is None else step

@@ -79,7 +79,7 @@ def minimise_to_stable(eq, path, U: np.ndarray, mu: np.ndarray, lam: float, log=
             # level there, so an energy test would only cut good steps)
             alpha, (R, W) = 1.0, eq.residual(U + dU, mu + dmu, lam)
         else:
-            step = _armijo(eq, U, mu, dmu, lam, dU, R, W)
+            step = _descent_step(eq, U, mu, dmu, lam, dU, R, W)
             if step is None:
                 return None     # no decrease of Π_ρ along dU: stuck
             alpha, R, W = step
@@ -96,28 +96,37 @@ def minimise_to_stable(eq, path, U: np.ndarray, mu: np.ndarray, lam: float, log=
     return None
 
 
-def _armijo(eq, U, mu_old, dmu, lam: float, dU, R, W, c1: float = 1e-4, max_cuts: int = 12):
-    """Backtracking on Π_ρ(U + α dU; μ_old + dμ, λ) until the Armijo decrease holds (a pure
-    energy criterion: a descent must not accept a step because |R| happens to fall):
-    (α, R, W) at the accepted α, or None if no α ≥ 2^-max_cuts decreases Π_ρ."""
+def armijo_step(eq, U, mu_old, dmu, lam: float, dU, R, W, c1: float = 1e-4,
+                max_cuts: int = 12, full=None):
+    """Backtracking on Π_ρ(U + α dU; μ_old + dμ, λ), α = 1, ½, … 2^-max_cuts, until the
+    Armijo decrease Π_ρ(α) ≤ Π_ρ(0) + c₁ α ∇Π_ρ·dU holds (App. E.2): (α, R, W) at the
+    accepted α, or None if dU is not a descent direction or no α decreases Π_ρ enough.
+    ``full``: (R, W) at α = 1 if the caller already has them."""
     mu = mu_old + dmu
     c = eq.C @ U - lam * eq.g
     grad = R + eq.C.T @ (dmu + (eq.rho or 0.0) * c)     # ∇Π_ρ(U; μ, λ)
     slope = float(grad @ dU)
-    phi0 = eq.merit(W, U, mu, lam)
     if not slope < 0:
-        if float(np.abs(dU).max(initial=0.0)) <= 1e-14 * max(float(np.abs(U).max(initial=0.0)),
-                                                              1e-300):
-            # nothing moves (the supports fix the step): only the multiplier changes
-            return (1.0, *eq.residual(U + dU, mu, lam))
         return None
+    phi0 = eq.merit(W, U, mu, lam)
     alpha = 1.0
     for _ in range(max_cuts + 1):
-        R_a, W_a = eq.residual(U + alpha * dU, mu, lam)
+        R_a, W_a = full if alpha == 1.0 and full is not None else eq.residual(U + alpha * dU,
+                                                                              mu, lam)
         if eq.merit(W_a, U + alpha * dU, mu, lam) <= phi0 + c1 * alpha * slope:
             return alpha, R_a, W_a
         alpha *= 0.5
     return None
+
+
+def _descent_step(eq, U, mu, dmu, lam: float, dU, R, W):
+    """:func:`armijo_step` for the descent (a pure energy criterion: it must not accept a
+    step because |R| happens to fall); a step the supports fix entirely (dU = 0) only
+    updates the multiplier. None: stuck."""
+    if float(np.abs(dU).max(initial=0.0)) <= 1e-14 * max(float(np.abs(U).max(initial=0.0)),
+                                                          1e-300):
+        return (1.0, *eq.residual(U + dU, mu + dmu, lam))
+    return armijo_step(eq, U, mu, dmu, lam, dU, R, W)
 
 
 def snap_amplitude(U_new: np.ndarray, U_old: np.ndarray, floor: Optional[float] = None) -> float:

@@ -8,17 +8,7 @@ from pointatlas_atlas.atlas import Atlas, AtlasSettings
 from pointatlas_atlas.projection import blended_map
 from pointatlas_atlas.surface_fit import fit_control_points
 
-
-def make_atlas(**kw):
-    s = AtlasSettings(**kw)
-    return Atlas(
-        s,
-        make_embedder=lambda: pointatlas.load_plugin("embedders", "pca")(n_components=2),
-        make_lme=lambda: pointatlas.load_plugin("approximants", "lme")(
-            gamma=s.gamma_lme, tol=s.tol_lme, outside="flag"),
-        make_pu=lambda: pointatlas.load_plugin("approximants", "shepard")(
-            gamma=s.gamma_pu, tol=s.tol_pu, outside="flag"),
-    )
+from .test_atlas import make_atlas
 
 
 def sphere_integrals(atlas):

@@ -40,8 +40,8 @@ class CubicSpring:
     def merit(self, W, U, mu, lam):
         return W - lam * float(self.F @ U)
 
-    def system(self, U):
-        K = csr_matrix(np.diag([1 - 3 * U[0] + 1.8 * U[0] ** 2, 1.0, 1.0]))
+    def system(self, U, shift: float = 0.0):
+        K = csr_matrix(np.diag([1 - 3 * U[0] + 1.8 * U[0] ** 2, 1.0, 1.0]) + shift * np.eye(3))
         sys = ConstrainedSystem(K, self.C, 1e3, 1e-12)
         self.rho = sys.rho
         return sys

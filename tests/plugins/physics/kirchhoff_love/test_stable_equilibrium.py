@@ -7,7 +7,6 @@ from scipy.sparse import csr_matrix
 
 import pointatlas_physics.kirchhoff_love.equilibrium as equilibrium
 from pointatlas_physics.kirchhoff_love.incremental import PathSettings, follow_path
-from pointatlas_physics.kirchhoff_love.solver import ConstrainedSystem
 from pointatlas_physics.kirchhoff_love.stable_equilibrium import (minimise_to_stable,
                                                                   snap_amplitude)
 
@@ -15,18 +14,11 @@ from .test_branch_switching import Pitchfork
 
 
 class ShiftablePitchfork(Pitchfork):
-    """Adds what the descent needs: Π_ρ and the shifted tangent K_T + σI."""
+    """Adds what the descent needs: Π_ρ with its constraint terms."""
 
     def merit(self, W, U, mu, lam):
         c = self.C @ U - lam * self.g
         return W - lam * float(self.F @ U) + float(mu @ c) + 0.5 * (self.rho or 0) * float(c @ c)
-
-    def system(self, U, shift: float = 0.0):
-        x, y, _ = U
-        K = np.array([[1.0, -y, 0.0], [-y, 1 - x + 3 * y * y, 0.0], [0, 0, 1.0]])
-        sys = ConstrainedSystem(csr_matrix(K + shift * np.eye(3)), self.C, 1e3, 1e-12)
-        self.rho = sys.rho
-        return sys
 
 
 def run(monkeypatch, stable_path: bool):
@@ -84,15 +76,8 @@ def test_past_a_limit_point_the_descent_finds_the_far_stable_branch():
 
     from .test_arc_length import CubicSpring, force
 
-    class ShiftableSpring(CubicSpring):
-        def system(self, U, shift: float = 0.0):
-            K = np.diag([1 - 3 * U[0] + 1.8 * U[0] ** 2, 1.0, 1.0]) + shift * np.eye(3)
-            sys = ConstrainedSystem(csr_matrix(K), self.C, 1e3, 1e-12)
-            self.rho = sys.rho
-            return sys
-
     U, mu, it, residuals, negative, snapped = minimise_to_stable(
-        ShiftableSpring(), PathSettings(tol=1e-12), np.array([0.3, 0.0, 0.0]), np.zeros(2), 0.3)
+        CubicSpring(), PathSettings(tol=1e-12), np.array([0.3, 0.0, 0.0]), np.zeros(2), 0.3)
     upper = (3 + np.sqrt(1.8)) / 3.6
     assert negative == 0 and snapped and U[0] > upper
     assert force(U[0]) == pytest.approx(0.3, abs=1e-10)
@@ -117,12 +102,6 @@ def test_an_imposed_displacement_is_applied_before_convergence_is_declared():
             self.g = np.array([1.0, 0.0, 0.0])      # u = λ, v = w = 0
 
         merit = ShiftablePitchfork.merit             # Π_ρ with the constraint terms
-
-        def system(self, U, shift: float = 0.0):
-            K = np.diag([1 - 3 * U[0] + 1.8 * U[0] ** 2, 1.0, 1.0]) + shift * np.eye(3)
-            sys = ConstrainedSystem(csr_matrix(K), self.C, 1e3, 1e-12)
-            self.rho = sys.rho
-            return sys
 
     U, mu, it, *_ = minimise_to_stable(ImposedSpring(), PathSettings(tol=1e-10), np.zeros(3),
                                        np.zeros(3), 0.3)

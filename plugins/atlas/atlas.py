@@ -84,7 +84,7 @@ class Atlas:
     def _margin_neighbors(self) -> tuple[np.ndarray, np.ndarray]:
         """Points within chart_margin·h of every point, as CSR (indptr, indices); built once."""
         if self._margin_csr is None:
-            r = self.settings.chart_margin * self.h_points_
+            r = self.settings.margin_for(self.chart_dim_) * self.h_points_
             near = self.point_tree_.query_ball_point(self.points_, r)
             counts = np.fromiter((len(n) for n in near), dtype=np.int64, count=len(near))
             indptr = np.concatenate([[0], np.cumsum(counts)])
@@ -127,6 +127,8 @@ class Atlas:
         self.point_tree_ = cKDTree(P)
         self._control_sets, self._embeddings, self._margin_csr = {}, {}, None
         self.h_points_ = float(np.median(self.point_tree_.query(P, k=2)[0][:, 1]))
+        # the chart dimension d, for d-dependent defaults (the embedders' n_components)
+        self.chart_dim_ = int(getattr(self.make_embedder(), "n_components", 2))
         self.pu_ = self.make_pu().fit(Q)
         self.W_points_ = self.pu_.evaluate(P, order=0).to_csr(Q.shape[0]).tocsc()
         n_parts = s.n_patches or max(1, int(round(Q.shape[0] / s.markers_per_patch)))

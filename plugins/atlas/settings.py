@@ -28,7 +28,8 @@ class AtlasSettings:
     #                                       points; 'global': one set of control points for
     #                                       all charts, the blend fits the points (Paper 2
     #                                       App. B; surface_fit.py)
-    chart_margin: float = 3.0             # extra control points within margin·h of supp ψ_κ
+    chart_margin: Optional[float] = None  # extra control points within margin·h of supp ψ_κ;
+    #                                       None: margin_for(d), 3 for d <= 2, 5 for d >= 3
     graph_neighbors: int = 10
     max_stress: float = 0.02              # accept a patch's embedding below this stress ...
     max_distortion: float = 2.5           # ... and this 95th-percentile singular-value ratio
@@ -45,6 +46,8 @@ class AtlasSettings:
         for name in ("gamma_lme", "tol_lme", "gamma_pu", "tol_pu", "chart_margin",
                      "max_stress", "max_distortion"):
             v = getattr(self, name)
+            if v is None and name == "chart_margin":
+                continue
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
                 raise ConfigError(f"{name} = {v!r} is invalid; it must be a finite number > 0.")
         if self.n_patches is not None and self.n_patches < 1:
@@ -56,3 +59,18 @@ class AtlasSettings:
         if self.markers_per_patch < 8:
             raise ConfigError(f"markers_per_patch = {self.markers_per_patch!r} is invalid; "
                               "it must be >= 8 (a patch needs enough markers to be embedded).")
+
+    def margin_for(self, d: int) -> float:
+        """The chart margin (in units of the median point spacing h) for d-dimensional charts.
+
+        An LME chart flattens towards the convex hull of its control points: its image there
+        is the chord between boundary points (Paper 1 §2.3, the ghost-node remark of Paper 2
+        §5.1), so supp ψ_κ must stay a few spacings inside the hull. 3h is enough on
+        surfaces; the hull of scattered points in d = 3 is more ragged, and on S^3 ⊂ R^4
+        (2 000 to 8 000 points) a 3h margin left 4 % of the quadrature weight on chords up
+        to 17 % inside the sphere while 5h brought the volume error down with N
+        (benchmarks/three_sphere_convergence.py). An explicit ``chart_margin`` wins.
+        """
+        if self.chart_margin is not None:
+            return float(self.chart_margin)
+        return 3.0 if int(d) <= 2 else 5.0

@@ -76,9 +76,12 @@ class PointFile:
         path: str = "???"
         intrinsic_dim: Optional[int] = None
         name: Optional[str] = None
-        #: keep at most this many points (a seeded random subset); None keeps all. Lets an
-        #: experiment's resolution key (source.n_points) apply to files too.
+        #: keep at most this many points; None keeps all. Lets an experiment's resolution
+        #: key (source.n_points) apply to files too.
         n_points: Optional[int] = None
+        #: how the n_points are chosen: 'farthest' (greedy farthest-point, quasi-uniform) or
+        #: 'random' (a seeded random subset)
+        subsample: str = "farthest"
 
     description: ClassVar[str] = "Point set read from a file (.npz, .ply, .vtk/.vtp, .csv/.txt)."
     parameter_constraints: ClassVar[dict[str, str]] = {
@@ -86,17 +89,28 @@ class PointFile:
         "intrinsic_dim": "None or an integer in [1, ambient dimension]",
         "name": "None (use the file stem) or a label",
         "n_points": "None or an integer >= 1 (at most this many points are kept)",
+        "subsample": "'farthest' (quasi-uniform subset, for accurate curvatures) or 'random'",
     }
 
     def __init__(self, *, path: str = "???", intrinsic_dim: Optional[int] = None,
-                 name: Optional[str] = None, n_points: Optional[int] = None):
+                 name: Optional[str] = None, n_points: Optional[int] = None,
+                 subsample: str = "farthest"):
         self.path = path
         self.intrinsic_dim = intrinsic_dim
         self.name = name
         self.n_points = n_points
+        self.subsample = subsample
 
     def load(self, rng: np.random.Generator | None = None) -> PointCloud:
-        """Read the file; ``rng`` chooses the subset when ``n_points`` is below the file's count."""
+        """Read the file; keep ``n_points`` of them if the file has more.
+
+        ``subsample='farthest'`` (default) keeps a quasi-uniform subset by greedy farthest-point
+        selection from a seeded start (O(n_points · N) time). Prefer it: second derivatives of
+        LME charts (curvatures, bending) are noisy on irregular nodes. On a sphere sampled at
+        random, 5 000 points give a Willmore energy 64 % off, while 5 000 farthest points of
+        20 000 random ones give 1.3 % (README, "Known limits"). ``'random'`` keeps a seeded
+        random subset.
+        """
         if not isinstance(self.path, (str, Path)) or str(self.path) in ("", "???"):
             raise ConfigError("path is missing: the 'file' source needs path=<file with points>, "
                               "e.g. source.path=data/points.npz on the command line.")
@@ -123,12 +137,22 @@ class PointFile:
         if d is not None and not (isinstance(d, (int, np.integer)) and 1 <= d <= points.shape[1]):
             raise ConfigError(f"intrinsic_dim={d!r} is invalid: must be None or an integer in "
                               f"[1, {points.shape[1]}] (the ambient dimension of {path}).")
+        if self.subsample not in ("farthest", "random"):
+            raise ConfigError(f"subsample={self.subsample!r} is invalid: use 'farthest' "
+                              "(quasi-uniform subset) or 'random' (seeded random subset).")
         n = self.n_points
         if n is not None:
             if not isinstance(n, (int, np.integer)) or n < 1:
                 raise ConfigError(f"n_points={n!r} is invalid: must be None or an integer >= 1.")
             if n < len(points):
                 rng = rng if rng is not None else np.random.default_rng(0)
-                points = points[np.sort(rng.choice(len(points), size=n, replace=False))]
+                if self.subsample == "farthest":
+                    from .farthest_point import farthest_point_order
+
+                    start = int(rng.integers(len(points)))
+                    keep = farthest_point_order(np.ascontiguousarray(points), int(n), start)
+                else:
+                    keep = rng.choice(len(points), size=n, replace=False)
+                points = points[np.sort(keep)]
         return PointCloud(points=points, markers=markers, intrinsic_dim=d,
                           name=self.name or path.stem)

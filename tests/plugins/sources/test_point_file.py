@@ -101,3 +101,25 @@ def test_n_points_keeps_a_seeded_subset(tmp_path):
     b = PointFile(path=str(tmp_path / "p.npz"), n_points=40).load(np.random.default_rng(1))
     assert a.points.shape == (40, 3) and np.array_equal(a.points, b.points)
     assert PointFile(path=str(tmp_path / "p.npz"), n_points=500).load(np.random.default_rng(1)).n_points == 100
+
+
+def test_farthest_subsample_is_quasi_uniform_and_random_is_available(tmp_path):
+    import numpy as np
+    from scipy.spatial import cKDTree
+    from pointatlas.errors import ConfigError
+    from pointatlas_sources.point_file import PointFile
+
+    X = np.random.default_rng(0).random((3000, 2))
+    np.savez(tmp_path / "p.npz", points=X)
+
+    def min_spacing(P):
+        return cKDTree(P).query(P, k=2)[0][:, 1].min()
+
+    far = PointFile(path=str(tmp_path / "p.npz"), n_points=300).load(np.random.default_rng(1))
+    rnd = PointFile(path=str(tmp_path / "p.npz"), n_points=300,
+                    subsample="random").load(np.random.default_rng(1))
+    assert far.n_points == rnd.n_points == 300
+    # 300 points in the unit square: mean spacing ≈ 0.058; farthest-point keeps pairs apart
+    assert min_spacing(far.points) > 0.03 and min_spacing(rnd.points) < 0.01
+    with pytest.raises(ConfigError, match="subsample='grid'"):
+        PointFile(path=str(tmp_path / "p.npz"), n_points=30, subsample="grid").load(None)

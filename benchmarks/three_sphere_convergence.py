@@ -101,7 +101,7 @@ def main(argv=None):
                     attrs={"title": "S^3 atlas convergence (benchmarks/three_sphere_convergence.py)"})
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = out.with_suffix(".tmp.nc")
+    tmp = out.with_name(out.name + ".tmp")
     ds.to_netcdf(tmp)
     tmp.replace(out)
     print(f"wrote {out}")

@@ -48,6 +48,9 @@ class LocalMaxEnt:
     max_iter : Newton iterations before a point is declared outside the hull.
     outside : 'error' raises InputError on points outside the convex hull of the nodes;
         'flag' marks them in ``BasisFunctions.outside`` and leaves their rows empty.
+    hessians : 'exact' (∂²p_a, Paper 1 App. A) or 'consistent' (the Hessian of the
+        LME-weighted quadratic least-squares fit, exact for quadratics on any nodes; see
+        :mod:`.consistent_hessians`). Use 'consistent' for curvatures on irregular nodes.
 
     The support nodes of x are those with |x - x_a| < r_a = sqrt(-ln(tol)/β_a). Where the
     dual cannot be solved on them (strongly varying h_a: x in a gap between clusters), x is
@@ -63,6 +66,7 @@ class LocalMaxEnt:
         newton_tol: float = 1e-12
         max_iter: int = 100
         outside: str = "error"
+        hessians: str = "exact"
 
     description: ClassVar[str] = "Local max-ent basis functions (nodal locality β_a = γ/h_a²)."
     parameter_constraints: ClassVar[dict[str, str]] = {
@@ -72,6 +76,7 @@ class LocalMaxEnt:
         "newton_tol": "float > 0",
         "max_iter": "int >= 1",
         "outside": "'error' or 'flag'",
+        "hessians": "'exact' or 'consistent'",
     }
 
 
@@ -81,6 +86,10 @@ class LocalMaxEnt:
         check_tol(self.tol, plugin=name)
         check_positive("newton_tol", self.newton_tol, plugin=name)
         check_outside(self.outside, plugin=name)
+        if self.hessians not in ("exact", "consistent"):
+            raise ConfigError(
+                f"LocalMaxEnt: hessians = {self.hessians!r} is invalid; use 'exact' (∂²p_a) or "
+                "'consistent' (second-order consistent, for curvatures on irregular nodes).")
         if isinstance(self.max_iter, bool) or not isinstance(self.max_iter, int) \
                 or self.max_iter < 1:
             raise ConfigError(
@@ -124,6 +133,15 @@ class LocalMaxEnt:
             indptr, arrays, status = self._retry(x, order, indptr, arrays, status)
             bad = status != K.OK
         indices, values, grads, hess = arrays
+        if order == 2 and self.hessians == "consistent":
+            from .consistent_hessians import consistent_hessians
+
+            keep = np.repeat(~bad, np.diff(indptr))
+            rows = np.concatenate([[0], np.cumsum(np.diff(indptr)[~bad])])
+            sub = np.ascontiguousarray(hess[keep])
+            consistent_hessians(rows, indices[keep], values[keep], self.nodes_, x[~bad],
+                                self.h_ref_, 1e6, sub)
+            hess[keep] = sub
         if not bad.any():
             return BasisFunctions(indptr, indices, values, grads, hess, None)
         if self.outside == "error":

@@ -20,6 +20,9 @@ class AtlasSettings:
     markers_per_patch: int = 150
     gamma_lme: float = 0.8
     tol_lme: float = 1e-10
+    chart_hessians: str = "exact"         # LME Hessians of the charts: 'exact' or 'consistent'
+    #                                       (exact for quadratics on irregular points; README
+    #                                       "Known limits")
     gamma_pu: float = 4.0
     tol_pu: float = 1e-6
     quadrature_order: int = 6
@@ -50,6 +53,10 @@ class AtlasSettings:
                 continue
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
                 raise ConfigError(f"{name} = {v!r} is invalid; it must be a finite number > 0.")
+        if self.chart_hessians not in ("exact", "consistent"):
+            raise ConfigError(f"chart_hessians = {self.chart_hessians!r} is invalid; use 'exact' "
+                              "(∂²p_a of the LME basis) or 'consistent' (second-order consistent "
+                              "Hessians, for curvatures on irregular points).")
         if self.n_patches is not None and self.n_patches < 1:
             raise ConfigError(f"n_patches = {self.n_patches!r} is invalid; use None or >= 1.")
         if self.least_squares_scope not in ("chart", "global"):

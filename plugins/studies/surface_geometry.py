@@ -39,6 +39,7 @@ class SurfaceGeometry:
         "markers_per_patch": "int >= 8",
         "gamma_lme": "float > 0 (thesis 0.8)", "tol_lme": "float in (0, 1) (thesis 1e-10)",
         "gamma_pu": "float > 0 (thesis 4–6)", "tol_pu": "float in (0, 1) (thesis 1e-6)",
+        "chart_hessians": "'exact' (thesis) or 'consistent' (irregular points)",
         "quadrature_order": "int >= 1 (thesis 6)", "chart_margin": "None (3 for d <= 2, 5 for d = 3) or float > 0",
         "max_stress": "float > 0", "max_distortion": "float > 1",
     }
@@ -64,7 +65,7 @@ class SurfaceGeometry:
             s,
             make_embedder=lambda: ctx.plugin("embedder"),
             make_lme=lambda: ctx.make("approximants", "lme", gamma=s.gamma_lme, tol=s.tol_lme,
-                                      outside="flag"),
+                                      outside="flag", hessians=s.chart_hessians),
             make_pu=lambda: ctx.make("approximants", "shepard", gamma=s.gamma_pu, tol=s.tol_pu,
                                      outside="flag"),
         )

@@ -35,6 +35,14 @@ class KirchhoffLove:
     def factories(ctx, atlas_settings) -> dict:
         """make_embedder / make_lme / make_pu for :func:`.analysis.build_model`."""
         a = atlas_settings
+        if getattr(a, "chart_hessians", "exact") != "exact":
+            from pointatlas.errors import ConfigError
+
+            raise ConfigError(
+                f"chart_hessians = {a.chart_hessians!r} is not available for shells: the bending "
+                "energy needs the exact LME Hessians (with the diffuse 'consistent' ones a "
+                "clamped plate comes out 57 % too soft). Remove the override; 'consistent' is "
+                "for curvature integrals (study=surface_geometry).")
         return dict(
             make_embedder=lambda: ctx.plugin("embedder"),
             make_lme=lambda: ctx.make("approximants", "lme", gamma=a.gamma_lme, tol=a.tol_lme,

@@ -34,3 +34,13 @@ def test_valid_settings_pass():
 def test_invalid_settings_are_named(kw, match):
     with pytest.raises(ConfigError, match=match):
         check_settings(_ok(**kw))
+
+
+def test_consistent_chart_hessians_are_refused_for_shells():
+    from pointatlas_atlas.settings import AtlasSettings
+    from pointatlas_physics.kirchhoff_love.plugin import KirchhoffLove
+
+    KirchhoffLove.factories(None, AtlasSettings())
+    with pytest.raises(ConfigError, match="chart_hessians = 'consistent' is not available for "
+                                          "shells.*surface_geometry"):
+        KirchhoffLove.factories(None, AtlasSettings(chart_hessians="consistent"))

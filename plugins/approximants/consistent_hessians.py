@@ -11,9 +11,9 @@ them by the Hessian of the weighted least-squares quadratic fit at x,
 the "diffuse derivative" of Nayroles, Touzot & Villon (Comput. Mech. 10:307, 1992) with the
 LME values as weights. Σ_a H̃_a f_a = ∂²f exactly for every quadratic f on any node set
 with a non-degenerate moment matrix (so Σ H̃_a = 0 and Σ H̃_a ⊗ x_a = 0), and the error for
-smooth f is O(h). H̃_a is not the derivative of ∇p_a: use it
-where curvatures are evaluated, not where a Galerkin tangent must be the derivative of the
-residual.
+smooth f is O(h). H̃_a is not the derivative of ∇p_a. Use it to evaluate curvatures; as
+the bending operator of a Kirchhoff–Love shell it made a clamped plate 57 % too soft
+(measured), so shells keep the exact Hessians.
 """
 from __future__ import annotations
 

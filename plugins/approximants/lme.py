@@ -136,12 +136,16 @@ class LocalMaxEnt:
         if order == 2 and self.hessians == "consistent":
             from .consistent_hessians import consistent_hessians
 
-            keep = np.repeat(~bad, np.diff(indptr))
-            rows = np.concatenate([[0], np.cumsum(np.diff(indptr)[~bad])])
-            sub = np.ascontiguousarray(hess[keep])
-            consistent_hessians(rows, indices[keep], values[keep], self.nodes_, x[~bad],
-                                self.h_ref_, 1e6, sub)
-            hess[keep] = sub
+            if not bad.any():   # in place
+                consistent_hessians(indptr, indices, values, self.nodes_, x, self.h_ref_, 1e6,
+                                    hess)
+            else:               # on the rows of the points where LME exists
+                keep = np.repeat(~bad, np.diff(indptr))
+                rows = np.concatenate([[0], np.cumsum(np.diff(indptr)[~bad])])
+                sub = np.ascontiguousarray(hess[keep])
+                consistent_hessians(rows, indices[keep], values[keep], self.nodes_, x[~bad],
+                                    self.h_ref_, 1e6, sub)
+                hess[keep] = sub
         if not bad.any():
             return BasisFunctions(indptr, indices, values, grads, hess, None)
         if self.outside == "error":

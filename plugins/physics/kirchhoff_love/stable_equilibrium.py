@@ -130,7 +130,7 @@ def _descent_step(eq, U, mu, dmu, lam: float, dU, R, W):
 
 
 def snap_amplitude(U_new: np.ndarray, U_old: np.ndarray, floor: Optional[float] = None) -> float:
-    """Perturbation size for :func:`descend_to_stable`: the increment's largest nodal
+    """Size of the kick off a saddle in :func:`minimise_to_stable`: the increment's largest nodal
     displacement (length), or ``floor`` if that is larger."""
     step = float(np.abs(np.asarray(U_new) - np.asarray(U_old)).max())
     return max(step, floor or 0.0)

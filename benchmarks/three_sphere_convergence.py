@@ -31,20 +31,23 @@ from pathlib import Path
 import numpy as np
 
 
-def build(n: int, margin, hessians: str = "exact", fit: bool = True):
+def build(n: int, margin, hessians: str = "exact", fit: bool = True,
+          reproduction: str = "linear"):
     import pointatlas
     from pointatlas_atlas.atlas import Atlas
     from pointatlas_atlas.settings import AtlasSettings
 
     s = AtlasSettings(markers_per_patch=30, max_refinement_depth=0, chart_margin=margin,
                       quadrature_order=2, max_stress=0.08, max_distortion=20.0,
-                      chart_hessians=hessians, least_squares_fit=fit)
+                      chart_hessians=hessians, least_squares_fit=fit,
+                      chart_reproduction=reproduction)
     pca = pointatlas.load_plugin("embedders", "pca")
     lme = pointatlas.load_plugin("approximants", "lme")
     shepard = pointatlas.load_plugin("approximants", "shepard")
     atlas = Atlas(s, make_embedder=lambda: pca(n_components=3),
                   make_lme=lambda: lme(gamma=s.gamma_lme, tol=s.tol_lme, outside="flag",
-                                       hessians=s.chart_hessians),
+                                       hessians=s.chart_hessians,
+                                       reproduction=s.chart_reproduction),
                   make_pu=lambda: shepard(gamma=s.gamma_pu, tol=s.tol_pu, outside="flag"))
     cloud = pointatlas.load_plugin("sources", "hypersphere")(n_points=n, radius=1.0).load(
         np.random.default_rng(0))
@@ -86,6 +89,8 @@ def main(argv=None):
     ap.add_argument("--margins", nargs="+", default=["3", "default"])
     ap.add_argument("--chart-hessians", default="exact", choices=["exact", "consistent"],
                     help="LME Hessians of the charts (consistent: exact for quadratics)")
+    ap.add_argument("--chart-reproduction", default="linear", choices=["linear", "quadratic", "cubic", "quartic"],
+                    help="charts Σ p_a P_a (linear) or the LME-weighted quadratic fit")
     ap.add_argument("--no-fit", action="store_true",
                     help="no least-squares fit of the control points")
     args = ap.parse_args(argv)
@@ -96,7 +101,8 @@ def main(argv=None):
     for m in args.margins:
         margin = None if m == "default" else float(m)
         for n in args.sizes:
-            r = build(n, margin, args.chart_hessians, not args.no_fit)
+            r = build(n, margin, args.chart_hessians, not args.no_fit,
+                      args.chart_reproduction)
             rows[(m, n)] = r
             print(f"{m:>8} {n:6d} {r['volume_error']:10.2e} {r['scalar_curvature_error']:10.2e} "
                   f"{r['mean_curvature_squared_error']:10.2e} "
@@ -110,6 +116,7 @@ def main(argv=None):
                                   "n_points": ("n_points", args.sizes, {"units": "1"})},
                     attrs={"title": "S^3 atlas convergence (benchmarks/three_sphere_convergence.py)",
                            "chart_hessians": args.chart_hessians,
+                           "chart_reproduction": args.chart_reproduction,
                            "least_squares_fit": int(not args.no_fit)})
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)

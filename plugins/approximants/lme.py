@@ -32,6 +32,9 @@ from .validation import (
     spacing_neighbors,
 )
 
+#: polynomial degree of each ``reproduction`` other than 'linear'
+POLYNOMIAL_DEGREE = {"quadratic": 2, "cubic": 3, "quartic": 4}
+
 
 @stores_config
 class LocalMaxEnt:
@@ -50,7 +53,16 @@ class LocalMaxEnt:
         'flag' marks them in ``BasisFunctions.outside`` and leaves their rows empty.
     hessians : 'exact' (∂²p_a, Paper 1 App. A) or 'consistent' (the Hessian of the
         LME-weighted quadratic least-squares fit, exact for quadratics on any nodes; see
-        :mod:`.consistent_hessians`). Use 'consistent' for curvatures on irregular nodes.
+        :mod:`.weighted_polynomial_fit`). Use 'consistent' for curvatures on irregular nodes.
+    reproduction : 'linear' (the LME basis) or 'quadratic', 'cubic', 'quartic': values,
+        gradients and Hessians of the weighted polynomial least-squares fit of that degree
+        instead (moving least squares on the LME support with LME's Gaussian prior
+        exp(-β_a|x - x_a|²) as weights,
+        :func:`.weighted_polynomial_fit.polynomial_fit_basis`), which reproduce polynomials
+        of that degree exactly on any nodes. For geometry on irregular points (an atlas
+        chart through samples: 'quartic' gives curvatures to ~1e-4 where LME's are O(1) off),
+        not as Galerkin shape functions: the values may be negative and the derivatives are
+        diffuse, not the derivatives of the values. Overrides ``hessians``.
 
     The support nodes of x are those with |x - x_a| < r_a = sqrt(-ln(tol)/β_a). Where the
     dual cannot be solved on them (strongly varying h_a: x in a gap between clusters), x is
@@ -67,6 +79,7 @@ class LocalMaxEnt:
         max_iter: int = 100
         outside: str = "error"
         hessians: str = "exact"
+        reproduction: str = "linear"
 
     description: ClassVar[str] = "Local max-ent basis functions (nodal locality β_a = γ/h_a²)."
     parameter_constraints: ClassVar[dict[str, str]] = {
@@ -77,6 +90,7 @@ class LocalMaxEnt:
         "max_iter": "int >= 1",
         "outside": "'error' or 'flag'",
         "hessians": "'exact' or 'consistent'",
+        "reproduction": "'linear', 'quadratic', 'cubic' or 'quartic'",
     }
 
 
@@ -90,6 +104,11 @@ class LocalMaxEnt:
             raise ConfigError(
                 f"LocalMaxEnt: hessians = {self.hessians!r} is invalid; use 'exact' (∂²p_a) or "
                 "'consistent' (second-order consistent, for curvatures on irregular nodes).")
+        if self.reproduction not in ("linear", *POLYNOMIAL_DEGREE):
+            raise ConfigError(
+                f"LocalMaxEnt: reproduction = {self.reproduction!r} is invalid; use 'linear' "
+                "(the LME basis) or 'quadratic', 'cubic', 'quartic' (the LME-weighted "
+                "polynomial fit of that degree, for geometry on irregular points).")
         if isinstance(self.max_iter, bool) or not isinstance(self.max_iter, int) \
                 or self.max_iter < 1:
             raise ConfigError(
@@ -133,19 +152,10 @@ class LocalMaxEnt:
             indptr, arrays, status = self._retry(x, order, indptr, arrays, status)
             bad = status != K.OK
         indices, values, grads, hess = arrays
-        if order == 2 and self.hessians == "consistent":
-            from .consistent_hessians import consistent_hessians
-
-            if not bad.any():   # in place
-                consistent_hessians(indptr, indices, values, self.nodes_, x, self.h_ref_, 1e6,
-                                    hess)
-            else:               # on the rows of the points where LME exists
-                keep = np.repeat(~bad, np.diff(indptr))
-                rows = np.concatenate([[0], np.cumsum(np.diff(indptr)[~bad])])
-                sub = np.ascontiguousarray(hess[keep])
-                consistent_hessians(rows, indices[keep], values[keep], self.nodes_, x[~bad],
-                                    self.h_ref_, 1e6, sub)
-                hess[keep] = sub
+        fit = self.reproduction != "linear"
+        if fit or (order == 2 and self.hessians == "consistent"):
+            grads, hess = self._second_order(x, bad, indptr, indices, values, grads, hess,
+                                             order, fit)
         if not bad.any():
             return BasisFunctions(indptr, indices, values, grads, hess, None)
         if self.outside == "error":
@@ -154,6 +164,42 @@ class LocalMaxEnt:
         indptr, (indices, values, grads, hess) = compact_rows(
             indptr, ~bad, indices, values, grads, hess)
         return BasisFunctions(indptr, indices, values, grads, hess, bad)
+
+    def _second_order(self, x, bad, indptr, indices, values, grads, hess, order, fit):
+        """Replace, in place on the rows of the points where LME exists, the Hessians
+        (hessians='consistent') or values, gradients and Hessians (reproduction other than
+        'linear') by those of the LME-weighted polynomial fit (:mod:`.weighted_polynomial_fit`)."""
+        from .weighted_polynomial_fit import consistent_hessians, polynomial_fit_basis
+
+        d = self.nodes_.shape[1]
+        nnz = len(values)
+        g = grads if order >= 1 else np.empty((nnz, d))
+        H = hess if order >= 2 else np.empty((nnz, d, d))
+        if bad.any():
+            keep = np.repeat(~bad, np.diff(indptr))
+            rows = np.concatenate([[0], np.cumsum(np.diff(indptr)[~bad])]).astype(indptr.dtype)
+            args = (rows, indices[keep], x[~bad])
+            sub = [np.ascontiguousarray(a[keep]) for a in (values, g, H)]
+        else:
+            args = (indptr, indices, x)
+            sub = [values, g, H]
+        if fit:
+            # the weights: LME's prior exp(-β_a |x - x_a|²) on its support, not p_a, whose
+            # tilt (λ) concentrates them on a few nodes at the rim of a gap in the samples,
+            # where the fit would then be ill-posed (measured on 20 000 random sphere points:
+            # Willmore error 6.3e-3 with p_a, 3.3e-4 with the prior)
+            row = np.repeat(np.arange(len(args[0]) - 1), np.diff(args[0]))
+            w = np.exp(-self.beta_[args[1]] * np.sum((self.nodes_[args[1]] - args[2][row]) ** 2,
+                                                     axis=1))
+            polynomial_fit_basis(args[0], args[1], sub[0], sub[1], self.nodes_, args[2],
+                                 self.h_ref_, 1e6, POLYNOMIAL_DEGREE[self.reproduction], sub[2],
+                                 w)
+        else:
+            consistent_hessians(args[0], args[1], sub[0], self.nodes_, args[2], self.h_ref_,
+                                1e6, sub[2])
+        if bad.any():
+            values[keep], g[keep], H[keep] = sub
+        return (grads if order >= 1 else None), (hess if order >= 2 else None)
 
     def _retry(self, x, order, indptr, arrays, status):
         """Solve failed points again with every node within R = max r_a, 2R, 4R, ...

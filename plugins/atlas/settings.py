@@ -23,6 +23,10 @@ class AtlasSettings:
     chart_hessians: str = "exact"         # LME Hessians of the charts: 'exact' or 'consistent'
     #                                       (exact for quadratics on irregular points; README
     #                                       "Known limits")
+    chart_reproduction: str = "linear"    # 'linear': charts Σ p_a P_a (thesis); 'quadratic',
+    #                                       'cubic', 'quartic': the LME-weighted polynomial fit
+    #                                       of the control points (curvatures on irregular
+    #                                       points; not for shells; README "Known limits")
     gamma_pu: float = 4.0
     tol_pu: float = 1e-6
     quadrature_order: int = 6
@@ -57,6 +61,11 @@ class AtlasSettings:
             raise ConfigError(f"chart_hessians = {self.chart_hessians!r} is invalid; use 'exact' "
                               "(∂²p_a of the LME basis) or 'consistent' (second-order consistent "
                               "Hessians, for curvatures on irregular points).")
+        if self.chart_reproduction not in ("linear", "quadratic", "cubic", "quartic"):
+            raise ConfigError(f"chart_reproduction = {self.chart_reproduction!r} is invalid; "
+                              "use 'linear' (LME charts, the thesis) or 'quadratic', 'cubic', "
+                              "'quartic' (the LME-weighted polynomial fit of that degree, for "
+                              "curvature on irregular points).")
         if self.n_patches is not None and self.n_patches < 1:
             raise ConfigError(f"n_patches = {self.n_patches!r} is invalid; use None or >= 1.")
         if self.least_squares_scope not in ("chart", "global"):

@@ -43,6 +43,14 @@ class KirchhoffLove:
                 "energy needs the exact LME Hessians (with the diffuse 'consistent' ones a "
                 "clamped plate comes out 57 % too soft). Remove the override; 'consistent' is "
                 "for curvature integrals (study=surface_geometry).")
+        if getattr(a, "chart_reproduction", "linear") != "linear":
+            from pointatlas.errors import ConfigError
+
+            raise ConfigError(
+                f"chart_reproduction = {a.chart_reproduction!r} is not available for shells: "
+                "the displacement basis must be the LME basis with its exact derivatives (the "
+                "quadratic fit's diffuse derivatives are not the derivatives of its values). "
+                "Remove the override; 'quadratic' is for geometry (study=surface_geometry).")
         return dict(
             make_embedder=lambda: ctx.plugin("embedder"),
             make_lme=lambda: ctx.make("approximants", "lme", gamma=a.gamma_lme, tol=a.tol_lme,

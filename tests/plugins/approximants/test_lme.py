@@ -171,5 +171,5 @@ def test_registry_entry_point_and_config(ax):
     assert B.n_points == 5 and B.hessians.shape == (B.indptr[-1], 2, 2)
     fields = set(cls.Config.__dataclass_fields__)
     assert fields == {"gamma", "tol", "n_spacing_neighbors", "newton_tol", "max_iter", "outside",
-                      "hessians"}
+                      "hessians", "reproduction"}
     assert cls.Config().gamma == 0.8 and cls.Config().tol == 1e-10

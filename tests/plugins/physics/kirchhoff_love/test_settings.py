@@ -44,3 +44,12 @@ def test_consistent_chart_hessians_are_refused_for_shells():
     with pytest.raises(ConfigError, match="chart_hessians = 'consistent' is not available for "
                                           "shells.*surface_geometry"):
         KirchhoffLove.factories(None, AtlasSettings(chart_hessians="consistent"))
+
+
+def test_polynomial_fit_charts_are_refused_for_shells():
+    from pointatlas_atlas.settings import AtlasSettings
+    from pointatlas_physics.kirchhoff_love.plugin import KirchhoffLove
+
+    with pytest.raises(ConfigError, match="chart_reproduction = 'quartic' is not available for "
+                                          "shells.*surface_geometry"):
+        KirchhoffLove.factories(None, AtlasSettings(chart_reproduction="quartic"))

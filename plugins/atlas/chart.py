@@ -246,17 +246,6 @@ def area_element(T: np.ndarray) -> np.ndarray:
     return np.sqrt(np.clip(a00 * a11 - a01 * a01, 0.0, None))
 
 
-def circumradius(simplices: np.ndarray) -> np.ndarray:
-    """Circumradii of the (m, d+1, d) simplices (d ≥ 2), in the units of the coordinates."""
-    v0 = simplices[:, 0]
-    E = simplices[:, 1:] - v0[:, None, :]               # (m, d, d) edge vectors
-    rhs = 0.5 * np.einsum("mij,mij->mi", E, E)
-    with np.errstate(all="ignore"):
-        c = np.linalg.solve(E + 0.0, rhs[..., None])[..., 0]   # centre - v0: E c = |e|²/2
-    r = np.linalg.norm(c, axis=1)
-    return np.where(np.isfinite(r), r, np.inf)
-
-
 def chart_quadrature(chart: Chart, support_at_nodes: np.ndarray, patch_pu: Callable,
                      order: int, tol_pu: float, need_second: bool = True,
                      real: np.ndarray | None = None, keep_basis: bool = False
@@ -278,10 +267,6 @@ def chart_quadrature(chart: Chart, support_at_nodes: np.ndarray, patch_pu: Calla
     else:
         simplices = Delaunay(xi).simplices
     keep = support_at_nodes[simplices].max(axis=1) > tol_pu * 1e-3
-    import os
-    alpha = float(os.environ.get("PA_ALPHA", "0"))
-    if alpha > 0 and d >= 2:
-        keep &= circumradius(xi[simplices]) < alpha * chart.approximant.h_ref_
     if real is not None:
         keep &= np.asarray(real, bool)[simplices].all(axis=1)
     simplices = simplices[keep]

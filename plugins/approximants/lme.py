@@ -107,8 +107,8 @@ class LocalMaxEnt:
         if self.reproduction not in ("linear", *POLYNOMIAL_DEGREE):
             raise ConfigError(
                 f"LocalMaxEnt: reproduction = {self.reproduction!r} is invalid; use 'linear' "
-                "(the LME basis) or 'quadratic', 'cubic', 'quartic' (the LME-weighted "
-                "polynomial fit of that degree, for geometry on irregular points).")
+                "(the LME basis) or 'quadratic', 'cubic', 'quartic' (the polynomial fit of "
+                "that degree on the LME support, for geometry on irregular points).")
         if isinstance(self.max_iter, bool) or not isinstance(self.max_iter, int) \
                 or self.max_iter < 1:
             raise ConfigError(
@@ -168,7 +168,7 @@ class LocalMaxEnt:
     def _second_order(self, x, bad, indptr, indices, values, grads, hess, order, fit):
         """Replace, in place on the rows of the points where LME exists, the Hessians
         (hessians='consistent') or values, gradients and Hessians (reproduction other than
-        'linear') by those of the LME-weighted polynomial fit (:mod:`.weighted_polynomial_fit`)."""
+        'linear') by those of the weighted polynomial fit (:mod:`.weighted_polynomial_fit`)."""
         from .weighted_polynomial_fit import consistent_hessians, polynomial_fit_basis
 
         d = self.nodes_.shape[1]

@@ -24,9 +24,10 @@ class AtlasSettings:
     #                                       (exact for quadratics on irregular points; README
     #                                       "Known limits")
     chart_reproduction: str = "linear"    # 'linear': charts Σ p_a P_a (thesis); 'quadratic',
-    #                                       'cubic', 'quartic': the LME-weighted polynomial fit
-    #                                       of the control points (curvatures on irregular
-    #                                       points; not for shells; README "Known limits")
+    #                                       'cubic', 'quartic': the polynomial least-squares fit
+    #                                       of the control points on the LME support
+    #                                       (curvatures on irregular points; not for shells;
+    #                                       README "Known limits")
     gamma_pu: float = 4.0
     tol_pu: float = 1e-6
     quadrature_order: int = 6
@@ -64,8 +65,8 @@ class AtlasSettings:
         if self.chart_reproduction not in ("linear", "quadratic", "cubic", "quartic"):
             raise ConfigError(f"chart_reproduction = {self.chart_reproduction!r} is invalid; "
                               "use 'linear' (LME charts, the thesis) or 'quadratic', 'cubic', "
-                              "'quartic' (the LME-weighted polynomial fit of that degree, for "
-                              "curvature on irregular points).")
+                              "'quartic' (the polynomial fit of that degree on the LME support, "
+                              "for curvature on irregular points).")
         if self.n_patches is not None and self.n_patches < 1:
             raise ConfigError(f"n_patches = {self.n_patches!r} is invalid; use None or >= 1.")
         if self.least_squares_scope not in ("chart", "global"):

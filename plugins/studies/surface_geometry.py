@@ -40,7 +40,8 @@ class SurfaceGeometry:
         "gamma_lme": "float > 0 (thesis 0.8)", "tol_lme": "float in (0, 1) (thesis 1e-10)",
         "gamma_pu": "float > 0 (thesis 4–6)", "tol_pu": "float in (0, 1) (thesis 1e-6)",
         "chart_hessians": "'exact' (thesis) or 'consistent' (irregular points)",
-        "chart_reproduction": "'linear' (thesis), 'quadratic', 'cubic', 'quartic' (irregular points)",
+        "chart_reproduction": "'linear' (thesis); 'quadratic', 'cubic', 'quartic' (irregular "
+                              "points)",
         "quadrature_order": "int >= 1 (thesis 6)",
         "chart_margin": "None (3 for d <= 2, 5 for d = 3) or float > 0",
         "max_stress": "float > 0", "max_distortion": "float > 1",

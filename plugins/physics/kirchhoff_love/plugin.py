@@ -49,8 +49,9 @@ class KirchhoffLove:
             raise ConfigError(
                 f"chart_reproduction = {a.chart_reproduction!r} is not available for shells: "
                 "the displacement basis must be the LME basis with its exact derivatives (the "
-                "quadratic fit's diffuse derivatives are not the derivatives of its values). "
-                "Remove the override; 'quadratic' is for geometry (study=surface_geometry).")
+                "polynomial fit's diffuse derivatives are not the derivatives of its values). "
+                "Remove the override; the polynomial-fit charts are for geometry "
+                "(study=surface_geometry).")
         return dict(
             make_embedder=lambda: ctx.plugin("embedder"),
             make_lme=lambda: ctx.make("approximants", "lme", gamma=a.gamma_lme, tol=a.tol_lme,

@@ -34,18 +34,18 @@ class KirchhoffLove:
     @staticmethod
     def factories(ctx, atlas_settings) -> dict:
         """make_embedder / make_lme / make_pu for :func:`.analysis.build_model`."""
-        a = atlas_settings
-        if getattr(a, "chart_hessians", "exact") != "exact":
-            from pointatlas.errors import ConfigError
+        from pointatlas.errors import ConfigError
 
+        a = atlas_settings
+        # the shell's make_lme below builds the plain LME basis: refuse the geometry-only chart
+        # options rather than ignore them
+        if getattr(a, "chart_hessians", "exact") != "exact":
             raise ConfigError(
                 f"chart_hessians = {a.chart_hessians!r} is not available for shells: the bending "
                 "energy needs the exact LME Hessians (with the diffuse 'consistent' ones a "
                 "clamped plate comes out 57 % too soft). Remove the override; 'consistent' is "
                 "for curvature integrals (study=surface_geometry).")
         if getattr(a, "chart_reproduction", "linear") != "linear":
-            from pointatlas.errors import ConfigError
-
             raise ConfigError(
                 f"chart_reproduction = {a.chart_reproduction!r} is not available for shells: "
                 "the displacement basis must be the LME basis with its exact derivatives (the "

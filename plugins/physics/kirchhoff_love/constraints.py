@@ -8,7 +8,9 @@ tangent basis), so:
 
 * displacement rows  e·u(x) = Σ_a p_a e·U_a
 * rotation rows      n·u_,α(x) = Σ_a p_a,α n·U_a        (clamped: δn = 0 ⇔ both vanish)
-* symmetry rows      δn·e = −Σ_α (a^α·e) n·u_,α          (the normal stays in the plane)
+* symmetry rows      p·u_,e = Σ_α (a^α·e) p·u_,α = 0, p = n and e × n: the derivative across
+                     the plane, φ_,e, stays parallel to e, so the normal stays in the plane
+                     (exact at any rotation; the p = n row alone is the linearised δn·e = 0)
 
 Rotation rows are scaled by the node spacing h so every row is a length (one penalty fits).
 """
@@ -114,8 +116,12 @@ def support_constraints(atlas, points: np.ndarray, boundary: np.ndarray, curves:
         if sup.kind == "symmetry":
             e = _unit(sup.normal)
             add(np.tile(e, (k, 1)))
-            c = dual @ e  # δn·e = −Σ_α (a^α·e) n·u_,α: one row from both derivatives
-            add([n * (spacing * c[:, a])[:, None] for a in range(2)], "gradient", (0, 1))
+            # φ_,e = Σ_α (a^α·e) φ_,α must stay parallel to e: both of its components in the
+            # plane vanish, p·u_,e = 0 for p = n and p = e × n. This is linear in U and exact
+            # at any rotation; the n row alone (δn·e = 0) is only its linearisation.
+            c = dual @ e
+            for p in (n, _unit_rows(np.cross(e, n))):
+                add([p * (spacing * c[:, a])[:, None] for a in range(2)], "gradient", (0, 1))
         if sup.kind == "diaphragm":
             e = _unit(sup.normal)
             t1 = np.cross(e, eye[np.argmin(np.abs(e))])
@@ -190,6 +196,10 @@ def boundary_quadrature(atlas, points, nodes, curves, spacing: float, n_gauss: i
     A = (coo((1.0 / np.asarray(A.sum(axis=1)).ravel(), (np.arange(len(nodes)),) * 2),
              shape=(len(nodes),) * 2) @ A).tocsr()
     return (np.asarray(charts, dtype=np.int64), np.asarray(xi).reshape(len(charts), -1), A)
+
+
+def _unit_rows(v: np.ndarray) -> np.ndarray:
+    return v / np.linalg.norm(v, axis=1, keepdims=True)
 
 
 def _unit(v) -> np.ndarray:

@@ -8,7 +8,8 @@ Supports (Paper 1 App. D, thesis App. E.2), each on the points a :class:`Selecto
 ========================  ===========================================================
 ``clamped``               u = 0 and the normal does not rotate, δn = 0
 ``simply_supported``      u = 0 (rotation free)
-``symmetry``              u·e = 0 and δn·e = 0, e = ``normal`` of the symmetry plane
+``symmetry``              u·e = 0 and u_,e ∥ e (the normal stays in the plane at any
+                          rotation), e = ``normal`` of the symmetry plane
 ``diaphragm``             rigid diaphragm of plane normal e: u − (u·e)e = 0
 ``fixed``                 u_i = 0 for i in ``components`` (0, 1, 2 = x, y, z)
 ``displacement``          u_i = ``value[i]`` for i in ``components`` (default all three)

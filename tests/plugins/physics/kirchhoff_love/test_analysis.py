@@ -105,3 +105,26 @@ def test_line_and_pressure_loads_total_their_resultants(solved):
     n = _quadrature_normals(model.quadrature, model.nodes)
     f = surface_load(model.quadrature, model.nodes.shape[0], pressure=2.0, normals=n)
     assert abs(f.sum(axis=0)[2]) == pytest.approx(2.0 * 25.0, rel=1e-8)
+
+
+def test_symmetry_rows_are_exact_under_large_rotation():
+    """Symmetry about x = 0 must hold the normal in the plane at any rotation: a finite
+    rotation about the plane's normal e is symmetric and passes; a tilt of the normal out of
+    the plane hidden behind a membrane shear (which the linearised row δn·e = 0 alone lets
+    through when the normal has rotated) is refused."""
+    from pointatlas_physics.kirchhoff_love.constraints import support_constraints
+
+    s = _settings()
+    model = _model(s)
+    cons = support_constraints(model.atlas, model.points, model.boundary, model.curves,
+                               [s.supports[2]], model.spacing, s.segment_points)
+    X = model.nodes
+    th, psi = np.radians(60.0), 0.05
+    Q = np.array([[1, 0, 0], [0, np.cos(th), -np.sin(th)], [0, np.sin(th), np.cos(th)]])
+    d, t = Q @ [0, 0, 1], Q @ [0, 1, 0]          # rotated normal and tangent, in the plane
+    rotated = X @ Q.T
+    sigma = -psi * np.cos(th) / np.sin(th)       # makes n_ref·u_,x vanish
+    tilted = rotated + X[:, :1] * (psi * d + sigma * t)
+    for phi, ok in ((rotated, True), (tilted, False)):
+        r = np.abs(cons.matrix @ (phi - X).ravel() - cons.rhs).max() / model.spacing
+        assert (r < 1e-8) if ok else (r > 0.5 * psi / np.sin(th))

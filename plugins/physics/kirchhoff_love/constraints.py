@@ -120,7 +120,14 @@ def support_constraints(atlas, points: np.ndarray, boundary: np.ndarray, curves:
             # plane vanish, p·u_,e = 0 for p = n and p = e × n. This is linear in U and exact
             # at any rotation; the n row alone (δn·e = 0) is only its linearisation.
             c = dual @ e
-            for p in (n, _unit_rows(np.cross(e, n))):
+            across = np.cross(e, n)
+            if np.linalg.norm(across, axis=1).min() < 0.5:
+                raise InputError(
+                    f"support {s_i} (symmetry, normal {list(sup.normal)}): the plane does not "
+                    "cut the surface at right angles at some selected points (the surface "
+                    "normal there is within 30° of the plane's normal). Give the normal of the "
+                    "symmetry plane itself, and select only points on that plane.")
+            for p in (n, _unit_rows(across)):
                 add([p * (spacing * c[:, a])[:, None] for a in range(2)], "gradient", (0, 1))
         if sup.kind == "diaphragm":
             e = _unit(sup.normal)

@@ -91,6 +91,11 @@ def test_load_off_the_surface_and_empty_selector_are_errors():
     s = _settings(supports=[Support(kind="clamped", where=Selector(plane=[1, 0, 0, 7.0]))])
     with pytest.raises(InputError, match="select"):
         solve_linear(_model(s), s)
+    # a "symmetry plane" parallel to the plate does not cut it: named, with the fix
+    s = _settings(supports=[Support(kind="symmetry", normal=[0, 0, 1],
+                                    where=Selector(plane=[1, 0, 0, 0.0]))])
+    with pytest.raises(InputError, match="does not cut the surface at right angles"):
+        solve_linear(_model(s), s)
 
 
 def test_line_and_pressure_loads_total_their_resultants(solved):

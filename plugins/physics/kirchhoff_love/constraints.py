@@ -116,18 +116,16 @@ def support_constraints(atlas, points: np.ndarray, boundary: np.ndarray, curves:
         if sup.kind == "symmetry":
             e = _unit(sup.normal)
             add(np.tile(e, (k, 1)))
-            # φ_,e = Σ_α (a^α·e) φ_,α must stay parallel to e: both of its components in the
-            # plane vanish, p·u_,e = 0 for p = n and p = e × n. This is linear in U and exact
-            # at any rotation; the n row alone (δn·e = 0) is only its linearisation.
-            c = dual @ e
+            c = dual @ e  # u_,e = Σ_α c_α u_,α; rows p·u_,e = 0, p = n, e × n (module doc)
             across = np.cross(e, n)
-            if np.linalg.norm(across, axis=1).min() < 0.5:
+            sine = np.linalg.norm(across, axis=1)
+            if sine.min() < 0.5:
                 raise InputError(
                     f"support {s_i} (symmetry, normal {list(sup.normal)}): the plane does not "
                     "cut the surface at right angles at some selected points (the surface "
                     "normal there is within 30° of the plane's normal). Give the normal of the "
                     "symmetry plane itself, and select only points on that plane.")
-            for p in (n, _unit_rows(across)):
+            for p in (n, across / sine[:, None]):
                 add([p * (spacing * c[:, a])[:, None] for a in range(2)], "gradient", (0, 1))
         if sup.kind == "diaphragm":
             e = _unit(sup.normal)
@@ -203,10 +201,6 @@ def boundary_quadrature(atlas, points, nodes, curves, spacing: float, n_gauss: i
     A = (coo((1.0 / np.asarray(A.sum(axis=1)).ravel(), (np.arange(len(nodes)),) * 2),
              shape=(len(nodes),) * 2) @ A).tocsr()
     return (np.asarray(charts, dtype=np.int64), np.asarray(xi).reshape(len(charts), -1), A)
-
-
-def _unit_rows(v: np.ndarray) -> np.ndarray:
-    return v / np.linalg.norm(v, axis=1, keepdims=True)
 
 
 def _unit(v) -> np.ndarray:

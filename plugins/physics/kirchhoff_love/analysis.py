@@ -158,7 +158,7 @@ def assemble_loads(model: ShellModel, settings, log=None) -> np.ndarray:
     for ld in settings.loads:
         if ld.kind == "point":
             f, where, dist = point_load(model.atlas, ld.at, ld.force, model.spacing,
-                                        settings.max_load_offset)
+                                        settings.max_load_offset, points=model.points)
             if log is not None:
                 log.info("point load %s at %s (projected %.3g away)", list(ld.force),
                          np.round(where, 6).tolist(), dist)

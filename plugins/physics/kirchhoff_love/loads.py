@@ -17,24 +17,49 @@ from pointatlas.errors import InputError
 from .selectors import describe, select
 
 
-def point_load(atlas, at, force, spacing: float, max_offset: float):
+def _vec(v) -> str:
+    return "[" + ", ".join(f"{c:.6g}" for c in np.asarray(v, dtype=np.float64).ravel()) + "]"
+
+
+def point_load(atlas, at, force, spacing: float, max_offset: float, points=None):
     """(F (N, 3), projected point, distance) of a point force at the surface point nearest
-    ``at``; more than ``max_offset`` spacings off the surface is an error."""
+    ``at`` (closest-point projection, Paper 2 App. A).
+
+    More than ``max_offset`` spacings (``spacing``: median point spacing h, length units)
+    off the surface is an :class:`InputError` giving the distance, the nearest surface point
+    and h. When the projection fails (no chart reaches the point), the distance is the one
+    to the nearest of ``points`` (default: the atlas's nodes; pass the sampled points so that
+    ghosts are not proposed).
+    """
     from pointatlas_atlas.evaluation import basis_at
     from pointatlas_atlas.projection import closest_point
 
     x = np.asarray(at, dtype=np.float64).reshape(1, 3)
     proj = closest_point(atlas, x, on_failure="flag")
-    dist = float(proj.distance[0]) if bool(proj.converged[0]) else np.inf
-    if not dist <= max_offset * spacing:
-        raise InputError(
-            f"the load point {list(at)} is {dist:.3g} off the surface (spacing {spacing:.3g}, "
-            f"allowed {max_offset} spacings): give a point on the shell (check the "
-            "coordinates and the model: full, quarter or eighth).")
-    basis = basis_at(atlas, proj.chart, proj.xi, order=0)
-    F = np.zeros((atlas.points_.shape[0], 3))
-    np.add.at(F, basis.indices, basis.values[:, None] * np.asarray(force, dtype=np.float64))
-    return F, proj.point[0], dist
+    converged = bool(proj.converged[0]) and np.isfinite(proj.distance[0])
+    allowed = max_offset * spacing
+    if converged and float(proj.distance[0]) <= allowed:
+        basis = basis_at(atlas, proj.chart, proj.xi, order=0)
+        F = np.zeros((atlas.points_.shape[0], 3))
+        np.add.at(F, basis.indices, basis.values[:, None] * np.asarray(force, dtype=np.float64))
+        return F, proj.point[0], float(proj.distance[0])
+    if converged:
+        dist, nearest = float(proj.distance[0]), proj.point[0]
+        where = f"the nearest surface point is {_vec(nearest)}"
+        other = f", or raise physics.max_load_offset (now {max_offset:g})"
+    else:
+        P = np.asarray(atlas.points_ if points is None else points, dtype=np.float64)
+        d = np.linalg.norm(P - x, axis=1)
+        dist, nearest = float(d.min()), P[int(np.argmin(d))]
+        where = ("the closest-point projection onto the surface failed (no chart reaches the "
+                 f"point), so this is the distance to the nearest sampled point {_vec(nearest)}")
+        other = ""
+    raise InputError(
+        f"the load point {_vec(x)} is {dist:.3g} off the surface ({dist / spacing:.3g} "
+        f"spacings; {where}; spacing h = {spacing:.3g}, a point load must lie within "
+        f"{allowed:.3g} = {max_offset:g} h of the surface). Fix: move the load point onto the "
+        f"surface, e.g. at: {_vec(nearest)} (check the coordinates and the model: full, "
+        f"quarter or eighth){other}.")
 
 
 def surface_load(quadrature, n_nodes: int, force=None, pressure=None, normals=None):

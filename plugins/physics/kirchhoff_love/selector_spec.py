@@ -12,7 +12,8 @@ class Selector:
 
     plane: [nx, ny, nz, d] — points with |n·x − d| ≤ tol·|n|.
     box: [xmin, ymin, zmin, xmax, ymax, zmax] — points inside, enlarged by tol.
-    expression: boolean expression of x, y, z, r, rho, theta, phi (see ``ALLOWED``).
+    expression: boolean expression of x, y, z, r, rho, theta, phi, at most 1000 characters
+        and 50 levels deep (the functions and their arguments: ``expression.ALLOWED``).
     nearest_curve: [x, y, z] — the boundary curve nearest to this point.
     on_boundary: restrict to boundary points (default True).
     tol: length tolerance; None = 0.25 × median point spacing.

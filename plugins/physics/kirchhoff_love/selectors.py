@@ -11,105 +11,17 @@ geometric criteria, all AND-ed::
     hole: {nearest_curve: [0, 0, 10]}                 # the boundary curve nearest to a point
     load: {box: [-0.1, -0.1, -1, 0.1, 0.1, 1], on_boundary: false}
 
-Expressions are parsed with :mod:`ast` and evaluated on numpy arrays from a whitelist only.
+Expressions are checked against a whitelist and evaluated on read-only copies of the
+coordinates by :mod:`.expression`.
 """
 from __future__ import annotations
-
-import ast
-import operator
 
 import numpy as np
 
 from pointatlas.errors import ConfigError, InputError
 
+from .expression import ALLOWED, FUNCTIONS, VARIABLES, evaluate_expression  # noqa: F401
 from .selector_spec import Selector, describe  # noqa: F401  (re-exported)
-
-#: Variables of an expression: coordinates, distances to the origin and to the z axis, the
-#: polar angle from +z (theta) and the azimuth about z (phi), radians.
-VARIABLES = ("x", "y", "z", "r", "rho", "theta", "phi")
-FUNCTIONS = {"abs": np.abs, "sqrt": np.sqrt, "sin": np.sin, "cos": np.cos, "tan": np.tan,
-             "arcsin": np.arcsin, "arccos": np.arccos, "arctan": np.arctan,
-             "arctan2": np.arctan2, "exp": np.exp, "log": np.log, "hypot": np.hypot,
-             "minimum": np.minimum, "maximum": np.maximum, "isclose": np.isclose}
-CONSTANTS = {"pi": np.pi, "e": np.e}
-_BINARY = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul,
-           ast.Div: operator.truediv, ast.Pow: operator.pow, ast.Mod: operator.mod}
-_UNARY = {ast.USub: operator.neg, ast.UAdd: operator.pos}
-_COMPARE = {ast.Lt: operator.lt, ast.LtE: operator.le, ast.Gt: operator.gt,
-            ast.GtE: operator.ge, ast.Eq: operator.eq, ast.NotEq: operator.ne}
-ALLOWED = ("numbers; variables " + ", ".join(VARIABLES) + "; constants "
-           + ", ".join(CONSTANTS) + "; functions " + ", ".join(FUNCTIONS)
-           + "; operators + - * / ** %, comparisons (chains allowed), and, or, not")
-
-
-def _reject(token: str, expression: str):
-    raise ConfigError(f"expression {expression!r}: {token} is not allowed. Allowed: {ALLOWED}.")
-
-
-def _evaluate(node, env: dict, expression: str):
-    """Evaluate a whitelisted expression tree on arrays."""
-    if isinstance(node, ast.Expression):
-        return _evaluate(node.body, env, expression)
-    if isinstance(node, ast.Constant):
-        if isinstance(node.value, (int, float)) and not isinstance(node.value, bool):
-            return np.float64(node.value)  # float arithmetic: 9**9**9 overflows to inf, fast
-        _reject(f"the constant {node.value!r}", expression)
-    if isinstance(node, ast.Name):
-        if node.id in env:
-            return env[node.id]
-        if node.id in CONSTANTS:
-            return CONSTANTS[node.id]
-        _reject(f"the name {node.id!r}", expression)
-    if isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
-        return _BINARY[type(node.op)](_evaluate(node.left, env, expression),
-                                      _evaluate(node.right, env, expression))
-    if isinstance(node, ast.UnaryOp) and type(node.op) in _UNARY:
-        return _UNARY[type(node.op)](_evaluate(node.operand, env, expression))
-    if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.Not):
-        return np.logical_not(_evaluate(node.operand, env, expression))
-    if isinstance(node, ast.BoolOp):
-        combine = np.logical_and if isinstance(node.op, ast.And) else np.logical_or
-        values = [_evaluate(v, env, expression) for v in node.values]
-        out = values[0]
-        for v in values[1:]:
-            out = combine(out, v)
-        return out
-    if isinstance(node, ast.Compare) and all(type(op) in _COMPARE for op in node.ops):
-        left = _evaluate(node.left, env, expression)
-        out = True
-        for op, right_node in zip(node.ops, node.comparators):
-            right = _evaluate(right_node, env, expression)
-            out = np.logical_and(out, _COMPARE[type(op)](left, right))
-            left = right
-        return out
-    if isinstance(node, ast.Call):
-        if not isinstance(node.func, ast.Name) or node.func.id not in FUNCTIONS:
-            _reject(f"the function {ast.unparse(node.func)!r}", expression)
-        if node.keywords:
-            _reject("keyword arguments", expression)
-        return FUNCTIONS[node.func.id](*(_evaluate(a, env, expression) for a in node.args))
-    _reject(f"{ast.unparse(node)!r} ({type(node).__name__})", expression)
-
-
-def evaluate_expression(expression: str, points: np.ndarray) -> np.ndarray:
-    """(N,) bool: the whitelisted boolean ``expression`` evaluated at ``points`` (N, 3)."""
-    try:
-        tree = ast.parse(expression.strip(), mode="eval")
-    except SyntaxError as err:
-        raise ConfigError(f"expression {expression!r} is not valid Python syntax ({err.msg}). "
-                          "Write e.g. \"abs(x - 5) < 1e-6 and y > 0\".") from None
-    x, y, z = points.T
-    rho = np.hypot(x, y)
-    r = np.sqrt(rho**2 + z**2)
-    env = {"x": x, "y": y, "z": z, "r": r, "rho": rho, "theta": np.arctan2(rho, z),
-           "phi": np.arctan2(y, x)}
-    with np.errstate(all="ignore"):
-        value = _evaluate(tree, env, expression)
-    value = np.broadcast_to(np.asarray(value), (len(points),))
-    if value.dtype != bool:
-        raise ConfigError(f"expression {expression!r} gives {value.dtype} values, not true/false. "
-                          "Compare something, e.g. \"abs(x - 5) < 1e-6\".")
-    return value
 
 
 def _vector(selector: Selector, field: str, size: int) -> np.ndarray:
@@ -173,7 +85,7 @@ def select(selector: Selector, points, boundary_mask, curves) -> np.ndarray:
         b = _vector(selector, "box", 6)
         keep &= np.all((X >= b[:3] - tol) & (X <= b[3:] + tol), axis=1)
     if selector.expression is not None:
-        keep &= evaluate_expression(str(selector.expression), X)
+        keep &= evaluate_expression(selector.expression, X)
     if selector.nearest_curve is not None:
         q = _vector(selector, "nearest_curve", 3)
         if not curves:

@@ -120,3 +120,20 @@ def check_settings(s) -> None:
                               "where the force acts.")
         if ld.kind == "line" and ld.where is None:
             raise ConfigError(f"physics.loads[{i}] (line) needs where: a boundary selector.")
+    _check_expressions(s)
+
+
+def _check_expressions(s) -> None:
+    """Selector expressions are parsed and checked at start-up (nothing is evaluated)."""
+    from .expression import parse_expression
+
+    for label, items in (("supports", s.supports), ("loads", s.loads)):
+        for i, item in enumerate(items):
+            where = getattr(item, "where", None)
+            expression = getattr(where, "expression", None) if where is not None else None
+            if expression is None:
+                continue
+            try:
+                parse_expression(expression)
+            except ConfigError as exc:
+                raise ConfigError(f"physics.{label}[{i}].where: {exc}") from None

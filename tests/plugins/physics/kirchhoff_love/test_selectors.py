@@ -55,7 +55,8 @@ def test_chained_comparisons_functions_and_logic():
 @pytest.mark.parametrize("expression, token", [
     ("__import__('os').system('ls')", "__import__"), ("x.real > 0", "Attribute"),
     ("open('f') or x > 0", "open"), ("q > 0", "'q'"), ("x if y else z", "IfExp"),
-    ("[x][0] > 1", "Subscript"), ("'a' == x", "'a'"), ("abs(x, key=1) > 0", "keyword"),
+    ("[x][0] > 1", "Subscript"), ("'a' == x", "'a'"), ("(lambda: x)() > 0", "lambda"),
+    ("[v for v in x] > 0", "ListComp"), ("x @ y > 0", "MatMult"), ("~x > 0", "Invert"),
 ])
 def test_forbidden_expressions_name_the_token_and_the_allowed_names(expression, token):
     with pytest.raises(ConfigError, match="Allowed") as info:

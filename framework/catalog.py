@@ -13,7 +13,9 @@ runs one short transaction, and retries on "database is locked"; the journal is 
 the outputs root on local disk or expect lock errors.
 
 Schema (version :data:`SCHEMA_VERSION`): ``runs`` (one row per run; overrides and params as
-JSON text), ``metrics`` (run_id, name, value; NULL stores NaN) and ``schema_version``.
+JSON text; the process that runs it: ``pid``, ``host``, ``pid_start`` and the ``heartbeat`` it
+refreshes, :mod:`pointatlas.liveness`), ``metrics`` (run_id, name, value; NULL stores NaN)
+and ``schema_version``. A row left ``running`` by a process that is gone reads as ``died``.
 Standard library only, so importing this module stays fast.
 """
 from __future__ import annotations
@@ -22,12 +24,12 @@ import json
 import math
 import os
 import sqlite3
-from dataclasses import dataclass, field
 from datetime import datetime
 from pathlib import Path
 from typing import Callable, Iterable, TypeVar
 
 from .errors import ConfigError, InputError, SchemaError
+from .catalog_rows import DIED, MISSING, RunRecord, records as _records  # noqa: F401
 from .sqlite_access import connect, immediate_transaction, read, retry, write
 from .run_filters import (  # noqa: F401 - re-exported
     METRIC_SYNTAX, WHERE_SYNTAX, MetricFilter, WhereFilter, overrides_as_dict, parse_metric,
@@ -35,12 +37,12 @@ from .run_filters import (  # noqa: F401 - re-exported
 )
 
 #: Version of the catalog schema this module writes and reads.
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 #: File name of the catalog inside the outputs root.
 CATALOG_FILENAME = "catalog.sqlite"
-#: Statuses stored in the catalog; "missing" is computed when the run directory is gone.
+#: Statuses stored in the catalog; "missing" is computed when the run directory is gone, and
+#: "died" for a run recorded as running whose process no longer exists.
 STATUSES = ("running", "completed", "failed")
-MISSING = "missing"
 
 
 _SCHEMA = """
@@ -56,7 +58,11 @@ CREATE TABLE IF NOT EXISTS runs (
     wall_time_s REAL,
     path TEXT,
     git_commit TEXT NOT NULL DEFAULT '',
-    error TEXT
+    error TEXT,
+    pid INTEGER,
+    host TEXT,
+    pid_start TEXT,
+    heartbeat TEXT
 );
 CREATE TABLE IF NOT EXISTS metrics (
     run_id TEXT NOT NULL REFERENCES runs(id) ON DELETE CASCADE,
@@ -69,8 +75,17 @@ CREATE INDEX IF NOT EXISTS runs_start_time ON runs(start_time);
 CREATE INDEX IF NOT EXISTS metrics_name ON metrics(name);
 """
 
-#: Migrations from version N to N+1 (executed inside one transaction). Empty at version 1.
-_MIGRATIONS: dict[int, Callable[[sqlite3.Connection], None]] = {}
+def _add_process_columns(conn: sqlite3.Connection) -> None:
+    """1 -> 2: the process running each run (pid, host, pid_start) and its heartbeat."""
+    have = {row[1] for row in conn.execute("PRAGMA table_info(runs)")}
+    for column, kind in (("pid", "INTEGER"), ("host", "TEXT"), ("pid_start", "TEXT"),
+                         ("heartbeat", "TEXT")):
+        if column not in have:
+            conn.execute(f"ALTER TABLE runs ADD COLUMN {column} {kind}")
+
+
+#: Migrations from version N to N+1 (executed inside one transaction).
+_MIGRATIONS: dict[int, Callable[[sqlite3.Connection], None]] = {1: _add_process_columns}
 
 T = TypeVar("T")
 
@@ -78,40 +93,6 @@ T = TypeVar("T")
 def catalog_path(outputs_root: str | Path) -> Path:
     """Path of the catalog file under an outputs root: ``<outputs_root>/catalog.sqlite``."""
     return Path(outputs_root) / CATALOG_FILENAME
-
-
-@dataclass
-class RunRecord:
-    """One run as recorded in the catalog.
-
-    ``status`` is "running", "completed" or "failed", or "missing" when the recorded run
-    directory no longer exists (the stored status is kept in ``recorded_status``).
-    Times are ISO 8601 strings (UTC), ``wall_time_s`` in seconds; ``metrics`` maps metric
-    name to value (NaN for a non-finite value stored as NULL).
-    """
-
-    id: str
-    experiment: str
-    overrides: list[str] = field(default_factory=list)
-    params: dict[str, str] = field(default_factory=dict)
-    status: str = "running"
-    start_time: str | None = None
-    end_time: str | None = None
-    wall_time_s: float | None = None
-    metrics: dict[str, float] = field(default_factory=dict)
-    path: str | None = None
-    git_commit: str = ""
-    error: str | None = None
-    recorded_status: str = ""
-
-    def settings(self) -> dict[str, str]:
-        """Parameters and overrides as one ``key -> value`` map (overrides win)."""
-        merged = {str(k): str(v) for k, v in self.params.items()}
-        merged.update(overrides_as_dict(self.overrides))
-        return merged
-
-
-# ----------------------------------------------------------------------------- filters
 
 
 # ----------------------------------------------------------------------------- catalog
@@ -131,16 +112,33 @@ class Catalog:
     # -- writing ---------------------------------------------------------------------------
 
     def start(self, *, run_id: str, experiment: str, overrides: list[str], path: str | None,
-              git_commit: str, start_time: str, params: dict[str, str] | None = None) -> None:
-        """Record a run that has started (status "running"); re-using an id replaces the run."""
+              git_commit: str, start_time: str, params: dict[str, str] | None = None,
+              process: dict | None = None) -> None:
+        """Record a run that has started (status "running"); re-using an id replaces the run.
+
+        ``process``: ``{"pid", "host", "pid_start"}`` of the process running it
+        (:func:`pointatlas.liveness.identity`), so that a killed run reads as "died".
+        """
+        process = process or {}
         row = {
             "id": _check_id(run_id), "experiment": str(experiment),
             "overrides": _json_list(overrides), "params": _json_params(params),
             "status": "running", "start_time": start_time, "end_time": None,
             "wall_time_s": None, "path": _abs_path(path), "git_commit": git_commit or "",
-            "error": None,
+            "error": None, "pid": process.get("pid"), "host": process.get("host"),
+            "pid_start": process.get("pid_start"),
+            "heartbeat": start_time if process else None,
         }
         self._write(lambda conn: _upsert(conn, row))
+
+    def forget(self, run_id: str) -> None:
+        """Delete a run's row and its metrics."""
+        self._write(lambda conn: conn.execute("DELETE FROM runs WHERE id=?", (run_id,)))
+
+    def heartbeat(self, run_id: str, time: str) -> None:
+        """Refresh the heartbeat of a running run (ISO 8601 time)."""
+        self._write(lambda conn: conn.execute(
+            "UPDATE runs SET heartbeat=? WHERE id=? AND status='running'", (time, run_id)))
 
     def finish(self, run_id: str, *, status: str, end_time: str, wall_time_s: float,
                metrics: dict[str, float], error: str | None = None) -> None:
@@ -193,9 +191,9 @@ class Catalog:
             metric = [metric]
         where_filters = [parse_where(text) for text in where]
         metric_filters = [parse_metric(text) for text in metric]
-        if status is not None and status not in (*STATUSES, MISSING):
+        if status is not None and status not in (*STATUSES, MISSING, DIED):
             raise ConfigError(f"status {status!r} is invalid: use one of "
-                              f"{', '.join((*STATUSES, MISSING))}")
+                              f"{', '.join((*STATUSES, MISSING, DIED))}")
         if limit is not None and limit < 0:
             raise ConfigError(f"limit {limit} is invalid: use a non-negative integer")
         sql, args = "SELECT * FROM runs", []
@@ -294,33 +292,6 @@ def _upsert(conn: sqlite3.Connection, row: dict) -> None:
         [row[c] for c in columns],
     )
     conn.execute("DELETE FROM metrics WHERE run_id=?", (row["id"],))
-
-
-def _records(conn: sqlite3.Connection, sql: str, args: list) -> list[RunRecord]:
-    rows = conn.execute(sql, args).fetchall()
-    if not rows:
-        return []
-    metrics: dict[str, dict[str, float]] = {}
-    ids = [row["id"] for row in rows]
-    for start in range(0, len(ids), 500):
-        chunk = ids[start:start + 500]
-        query = (f"SELECT run_id, name, value FROM metrics WHERE run_id IN "
-                 f"({', '.join('?' * len(chunk))}) ORDER BY rowid")
-        for run_id, name, value in conn.execute(query, chunk):
-            metrics.setdefault(run_id, {})[name] = math.nan if value is None else float(value)
-    return [_record(row, metrics.get(row["id"], {})) for row in rows]
-
-
-def _record(row: sqlite3.Row, metrics: dict[str, float]) -> RunRecord:
-    stored = row["status"]
-    path = row["path"]
-    status = MISSING if path and not os.path.exists(path) else stored
-    return RunRecord(
-        id=row["id"], experiment=row["experiment"], overrides=list(json.loads(row["overrides"])),
-        params=dict(json.loads(row["params"])), status=status, start_time=row["start_time"],
-        end_time=row["end_time"], wall_time_s=row["wall_time_s"], metrics=metrics, path=path,
-        git_commit=row["git_commit"], error=row["error"], recorded_status=stored,
-    )
 
 
 def _check_id(run_id: str) -> str:

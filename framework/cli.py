@@ -10,6 +10,7 @@ from __future__ import annotations
 import logging
 import re
 import sys
+from pathlib import Path
 
 from .config import CONF_DIR, plugin_config_class, register_configs, valid_keys
 from .errors import ConfigError, PluginError, PointatlasError
@@ -47,7 +48,9 @@ def explain(exc: Exception, overrides: list[str]) -> str:
     """Turn a Hydra composition error into one message naming the problem and the fix."""
     text = str(exc)
     for override in overrides:
-        key, _, value = override.lstrip("+~").partition("=")
+        if override.startswith("~"):
+            continue  # a deletion ('~experiment') names nothing to look up
+        key, _, value = override.lstrip("+").partition("=")
         if key in FAMILIES.values() and value and value != "null":
             load_plugin(key, value)  # unknown: lists installed names; broken: says why
         from .config import experiments
@@ -98,17 +101,55 @@ def _valid_keys_for(family: str, overrides: list[str]) -> list[str]:
     return valid_keys(config) if config else []
 
 
-def check_composition(overrides: list[str]) -> None:
-    """Compose the run config once; raise ConfigError/PluginError with a clear message."""
+def _compose(overrides: list[str]):
     from hydra import compose, initialize_config_dir
     from hydra.errors import HydraException
+    from omegaconf import OmegaConf, open_dict
     from omegaconf.errors import OmegaConfBaseException
 
     try:
         with initialize_config_dir(config_dir=str(CONF_DIR), version_base=VERSION_BASE):
-            compose("config", overrides=overrides)
+            cfg = compose("config", overrides=overrides, return_hydra_config=True)
+            choices = {k: v for k, v in cfg.hydra.runtime.choices.items()
+                       if not k.startswith("hydra")}
+            sweeper = OmegaConf.to_container(cfg.hydra.sweeper, resolve=False)
+            sweeper["mode"] = str(cfg.hydra.mode)
+            with open_dict(cfg):
+                del cfg["hydra"]
+            return OmegaConf.to_container(cfg, resolve=True), choices, sweeper
     except (HydraException, OmegaConfBaseException, ValueError) as exc:
         raise ConfigError(explain(exc, overrides)) from exc
+
+
+def check_composition(overrides: list[str], multirun: bool = False) -> bool:
+    """Compose the run config (every job's, for a sweep) and check it
+    (:func:`pointatlas.config_check.check_run_config`); raise ConfigError/PluginError with a
+    clear message naming the job. Returns whether the command is a sweep (``-m``, or a config
+    such as ``sweep=n_points`` that sets ``hydra.mode: MULTIRUN``)."""
+    from .config_check import check_run_config
+
+    task = [o for o in overrides if not o.startswith("hydra")]
+    config, choices, sweeper = _compose(task if not multirun else [
+        o for o in task if "," not in o and "(" not in o])
+    jobs = [task]
+    multirun = multirun or sweeper.get("mode") == "MULTIRUN"
+    if multirun:
+        from .sweep_guard import job_overrides
+
+        try:
+            jobs = job_overrides(task, (sweeper or {}).get("params"))
+        except Exception:  # noqa: BLE001 - a sweep syntax Hydra itself will explain
+            jobs = []
+    for job in jobs:
+        if job != task or not multirun:
+            config, choices, _ = _compose(job)
+        try:
+            check_run_config(config, choices)
+        except ConfigError as exc:
+            if len(jobs) > 1:
+                raise ConfigError(f"sweep job {' '.join(job)}: {exc}") from None
+            raise
+    return multirun
 
 
 def _task(cfg) -> None:
@@ -126,30 +167,41 @@ def _task(cfg) -> None:
         run_dir=hc.runtime.output_dir,
         experiment=choices.get("experiment") or "default",
         config_yaml=OmegaConf.to_yaml(cfg, resolve=True),
+        run_id=_EARLY.get("run_id") if hc.mode.name == "RUN" else _job_run_id(),
     )
 
 
-def _record_start_failure(overrides: list[str], message: str) -> None:
-    """A run that could not even start is still recorded in the catalog (status failed)."""
-    from .catalog import Catalog, catalog_path
-    from .provenance import git_commit, now_iso
-    from .run import new_run_id
+def _job_run_id() -> str | None:
+    from .sweep_guard import JOB
 
-    root = next((o.split("=", 1)[1] for o in overrides if o.startswith("outputs_root=")), "outputs")
-    experiment = next((o.split("=", 1)[1] for o in overrides if o.startswith("experiment=")), "default")
-    now = now_iso()
-    try:
-        Catalog(catalog_path(root)).record_failure(
-            run_id=new_run_id(), experiment=experiment, overrides=overrides, path=None,
-            git_commit=git_commit(), start_time=now, end_time=now, error=message)
-    except Exception as exc:  # noqa: BLE001 - the config error is what the user must see
-        log.warning("could not record the failed run in the catalog: %s", exc)
+    return JOB.get("run_id")
+
+
+#: the run recorded by :func:`main` before any heavy import (single runs only)
+_EARLY: dict = {}
+
+
+def _record_early(overrides: list[str]) -> None:
+    """Record a single run in the catalog with its process before anything heavy happens, so a
+    run killed during start-up still has a row (it reads as 'died')."""
+    from .provenance import now_iso
+    from .run import new_run_id
+    from .run_record import RunRecorder
+
+    root = next((o.split("=", 1)[1] for o in overrides if o.startswith("outputs_root=")),
+                "outputs")
+    experiment = next((o.split("=", 1)[1] for o in overrides if o.startswith("experiment=")),
+                      "default")
+    if Path(root).exists() and not Path(root).is_dir():
+        return  # refused by the start-up check, with the fix
+    record = RunRecorder(root, new_run_id())
+    record.start(experiment=experiment, overrides=list(overrides), path=None, git_commit="",
+                 start_time=now_iso())
+    _EARLY.update(run_id=record.run_id, record=record)
 
 
 def main(argv: list[str] | None = None) -> None:
     """Console entry point of ``pointatlas``."""
-    import hydra
-
     argv = sys.argv[1:] if argv is None else argv
     if argv and argv[0] in ("--help", "-h"):
         from .cli_help import help_text
@@ -157,31 +209,71 @@ def main(argv: list[str] | None = None) -> None:
         print(help_text())
         return
     overrides, multirun, info = split_argv(argv)
+    _EARLY.clear()
+    if not (info or multirun):
+        _record_early(overrides)
     try:
         register_configs()
-        if not info:
-            check_composition([o for o in overrides if not o.startswith("hydra")] if not multirun
-                              else [o for o in overrides if "," not in o and not o.startswith("hydra")
-                                    and "(" not in o])
+        if not info and check_composition(overrides, multirun) and not multirun:
+            multirun = True  # a config that sets hydra.mode: MULTIRUN (sweep=...)
+            if "record" in _EARLY:
+                _EARLY.pop("record").forget()
     except PointatlasError as exc:
         print(f"pointatlas: error: {exc}", file=sys.stderr)
-        _record_start_failure(overrides, str(exc))
+        if "record" not in _EARLY:
+            _record_early(overrides)
+        if "record" in _EARLY:
+            _EARLY["record"].failed(wall_time_s=None, error=str(exc))
         sys.exit(2)
+    import hydra
+
     sys.argv = [sys.argv[0], *argv]
     app = hydra.main(config_path=str(CONF_DIR), config_name="config", version_base=VERSION_BASE)(_task_safe)
-    app()
+    if not multirun:
+        app()
+        return
+    from . import sweep_guard
+
+    sweep_guard.CURRENT.clear()
+    code = 0
+    try:
+        app()
+    except SystemExit as exc:
+        code = exc.code if isinstance(exc.code, int) else 1
+    message = sweep_guard.summary(sweep_guard.CURRENT.get("sweep_dir"),
+                                  sweep_guard.CURRENT.get("jobs"))
+    if message:
+        print(f"pointatlas: error: {message}", file=sys.stderr)
+        sys.exit(1)
+    if code:
+        sys.exit(code)
 
 
 def _task_safe(cfg) -> None:
+    from hydra.core.hydra_config import HydraConfig
+
     try:
         _task(cfg)
     except PointatlasError as exc:
-        from hydra.core.hydra_config import HydraConfig
-
         if HydraConfig.get().mode.name == "RUN":
             print(f"pointatlas: error: {exc}", file=sys.stderr)
             sys.exit(1)
-        raise
+        _job_failed(exc)
+    except Exception as exc:  # noqa: BLE001 - one job of a sweep: the others go on
+        if HydraConfig.get().mode.name == "RUN":
+            raise
+        _job_failed(exc)
+
+
+def _job_failed(exc: BaseException) -> None:
+    """A failed job of a sweep: one line (error.txt in its folder has the details); the sweep
+    goes on and its exit message lists the jobs to rerun."""
+    from hydra.core.hydra_config import HydraConfig
+
+    hc = HydraConfig.get()
+    first = (str(exc).strip().splitlines() or [type(exc).__name__])[0]
+    print(f"pointatlas: error: job {hc.job.num} ({' '.join(hc.overrides.task)}): {first} "
+          f"(details: {Path(hc.runtime.output_dir) / 'error.txt'})", file=sys.stderr)
 
 
 __all__ = ["main", "PluginError"]

@@ -4,7 +4,10 @@ A results file is an xarray Dataset with named dims and coords, ``long_name``/``
 every variable, scalar metrics as 0-d variables and the provenance as global attrs
 (see :data:`REQUIRED_ATTRS`). Writing goes to a temporary file in the same directory that
 is renamed over ``results.nc`` only when complete, so a killed run never leaves a
-truncated file.
+truncated file; the temporary files a killed write leaves behind (``.results.nc.*.tmp``) are
+removed by the next run in that directory (:func:`remove_partial_files`) and by
+``pointatlas-runs gc``. Results files get the permissions of the user's umask, like every
+other file a run writes.
 """
 from __future__ import annotations
 
@@ -18,9 +21,9 @@ import numpy as np
 import xarray as xr
 
 from .errors import InputError, SchemaError
+from .run_files import PARTIAL_PATTERNS, RESULTS_NAME, remove_partial_files  # noqa: F401
 
 SCHEMA_VERSION = 1
-RESULTS_NAME = "results.nc"
 REQUIRED_ATTRS = (
     "Conventions", "title", "source", "history", "config", "overrides", "git_commit",
     "seed", "hostname", "wall_time_s", "status",
@@ -33,6 +36,8 @@ def attr_value(value: Any):
         return ""
     if isinstance(value, (bool, np.bool_)):
         return int(value)
+    if isinstance(value, (int, np.integer)) and not -2**63 <= int(value) < 2**63:
+        return np.uint64(value)  # seeds up to 2**64 - 1 (netCDF 'u8')
     if isinstance(value, (str, int, float, np.integer, np.floating)):
         return value
     if isinstance(value, np.ndarray) and value.dtype.kind in "iuf":
@@ -85,13 +90,55 @@ def write_results(ds: xr.Dataset, path: str | os.PathLike, attrs: dict | None = 
     out.attrs = clean_attrs({**ds.attrs, **(attrs or {}), "pointatlas_schema": SCHEMA_VERSION})
     for name in list(out.variables):
         out[name].attrs = clean_attrs(out[name].attrs)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
+    tmp = _temporary_name(path)
     try:
         out.to_netcdf(tmp, engine="netcdf4")
-        with open(tmp, "rb") as fh:
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
+        _publish(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def _temporary_name(path: Path) -> str:
+    """A fresh name ``.<name>.<random>.tmp`` beside ``path`` (created empty, umask mode)."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    os.chmod(tmp, 0o666 & ~_umask())
+    return tmp
+
+
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def _publish(tmp: str, path: Path) -> None:
+    """fsync ``tmp``, rename it over ``path`` and fsync the directory (the rename is durable)."""
+    with open(tmp, "rb") as fh:
+        os.fsync(fh.fileno())
+    os.replace(tmp, path)
+    try:
+        dir_fd = os.open(path.parent, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(dir_fd)
+    except OSError:
+        pass
+    finally:
+        os.close(dir_fd)
+
+
+def write_text_atomic(path: str | os.PathLike, text: str) -> Path:
+    """Write a small text file under its final name only once complete."""
+    path = Path(path)
+    tmp = _temporary_name(path)
+    try:
+        with open(tmp, "w") as fh:
+            fh.write(text)
+        _publish(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
@@ -116,8 +163,17 @@ def open_run(path: str | os.PathLike) -> xr.Dataset:
     Raises :class:`~pointatlas.errors.SchemaError` for a file written by a newer schema.
     """
     target = results_path(path)
-    with xr.open_dataset(target, engine="netcdf4") as ds:
-        ds = ds.load()
+    try:
+        with xr.open_dataset(target, engine="netcdf4") as ds:
+            ds = ds.load()
+    except (OSError, ValueError, RuntimeError, KeyError) as exc:
+        size = target.stat().st_size if target.exists() else 0
+        what = "is empty (0 bytes)" if size == 0 else f"is not a readable netCDF file ({exc})"
+        raise InputError(
+            f"{target} {what}: the run that wrote it did not finish, or the file was damaged "
+            "afterwards. Rerun that run (its config is in .hydra/config.yaml beside it) or "
+            "remove the directory."
+        ) from None
     version = int(ds.attrs.get("pointatlas_schema", 0))
     if version > SCHEMA_VERSION:
         raise SchemaError(

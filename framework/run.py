@@ -1,6 +1,7 @@
 """The run pipeline: seed, build the study's context, run it, write results, catalog it."""
 from __future__ import annotations
 
+import json
 import logging
 import random
 import time
@@ -10,15 +11,19 @@ from pathlib import Path
 
 import numpy as np
 
-from .catalog import Catalog, catalog_path
 from .context import RunContext
 from .errors import PointatlasError
 from .provenance import command_line, git_commit, hostname, now_iso, source_attr
 from .registry import FAMILIES
-from .results import RESULTS_NAME, check_variables, metric_names, metric_values, write_results
+from .results import (check_variables, metric_names, metric_values, write_results,
+                      write_text_atomic)
+from .run_files import ERROR_FILE, RESULTS_NAME, RUN_FILE, remove_partial_files
+from .liveness import identity
+from .run_record import RunRecorder
 
 log = logging.getLogger("pointatlas.run")
 PLUGIN_FAMILIES = tuple(FAMILIES.values())
+
 
 
 def new_run_id() -> str:
@@ -33,7 +38,7 @@ def seed_everything(seed: int) -> None:
 
 
 def run_study(*, config: dict, choices: dict[str, str], overrides: list[str], run_dir: Path,
-              experiment: str = "default", config_yaml: str = "") -> Path:
+              experiment: str = "default", config_yaml: str = "", run_id: str | None = None) -> Path:
     """Run the selected study and write ``run_dir/results.nc``; record it in the catalog.
 
     Parameters
@@ -41,63 +46,72 @@ def run_study(*, config: dict, choices: dict[str, str], overrides: list[str], ru
     config : resolved run config (plain dicts)
     choices : family -> plugin name selected for the run (``study`` is required)
     overrides : the command-line overrides of this run (for the catalog and sweeps)
+    run_id : the id under which the command line already recorded this run (a new one if None)
+
+    Whatever fails after the run is recorded (the study, the results write, the metrics)
+    marks the run ``failed`` in the catalog with its message and writes ``error.txt``; a
+    catalog that cannot be used is reported once and does not stop the run.
     """
     run_dir = Path(run_dir)
     run_dir.mkdir(parents=True, exist_ok=True)
+    remove_partial_files(run_dir)
     seed = int(config.get("seed", 0))
-    catalog = Catalog(catalog_path(config.get("outputs_root", "outputs")))
-    run_id, commit, start = new_run_id(), git_commit(), now_iso()
+    run_id = run_id or new_run_id()
+    record = RunRecorder(config.get("outputs_root", "outputs"), run_id)
+    commit, start = git_commit(), now_iso()
     plugins = {f: n for f, n in choices.items() if f in PLUGIN_FAMILIES and n}
-    catalog.start(run_id=run_id, experiment=experiment, overrides=list(overrides),
-                  path=str(run_dir.resolve()), git_commit=commit, start_time=start,
-                  params={**{f: n for f, n in plugins.items()}, "seed": str(seed)})
+    record.start(experiment=experiment, overrides=list(overrides), path=str(run_dir.resolve()),
+                 git_commit=commit, start_time=start,
+                 params={**{f: n for f, n in plugins.items()}, "seed": str(seed)})
+    record.start_heartbeat()
+    write_text_atomic(run_dir / RUN_FILE, json.dumps({
+        "run_id": run_id, "experiment": experiment, "overrides": list(overrides),
+        "params": {**plugins, "seed": str(seed)}, "git_commit": commit, "start_time": start,
+        **identity()}, indent=1) + "\n")
     t0 = time.perf_counter()
     if config.get("quiet"):
         logging.getLogger("pointatlas").setLevel(logging.WARNING)
-    ctx = RunContext(config=config, choices=plugins, seed=seed, run_dir=run_dir)
     try:
+        ctx = RunContext(config=config, choices=plugins, seed=seed, run_dir=run_dir)
         seed_everything(seed)
         study = ctx.plugin("study")
         log.info("run %s: experiment=%s study=%s in %s", run_id, experiment, plugins["study"], run_dir)
         ds = study.run(ctx)
         check_variables(ds)
-    except BaseException as exc:
         wall = time.perf_counter() - t0
+        for label, seconds in sorted(ctx.timings.items()):
+            ds[f"time_{label}"] = ((), seconds, {"long_name": f"wall time of {label}", "units": "s"})
+        references = getattr(type(study), "references", {}) or {}
+        attrs = {
+            "Conventions": "CF-1.10",
+            "title": config.get("title") or ds.attrs.get("title") or f"pointatlas {experiment}",
+            "source": source_attr(plugins),
+            "history": f"{start}: {command_line()}",
+            "config": config_yaml,
+            "overrides": list(overrides),
+            "git_commit": commit,
+            "seed": seed,
+            "hostname": hostname(),
+            "wall_time_s": wall,
+            "status": "completed",
+            "start_time": start,
+            "end_time": now_iso(),
+            "run_id": run_id,
+            "experiment": experiment,
+            "study": plugins["study"],
+            "plugins": plugins,
+            "metrics": metric_names(ds),
+            "references": references,
+        }
+        metrics = metric_values(ds)
+        path = write_results(ds, run_dir / RESULTS_NAME, attrs)
+    except BaseException as exc:
         message = str(exc) if isinstance(exc, PointatlasError) else (
             f"{type(exc).__name__}: {exc}\n{traceback.format_exc()}")
-        catalog.finish(run_id, status="failed", end_time=now_iso(), wall_time_s=wall,
-                       metrics={}, error=message or type(exc).__name__)
-        (run_dir / "error.txt").write_text(message + "\n")
+        record.failed(wall_time_s=time.perf_counter() - t0, error=message or type(exc).__name__)
+        write_text_atomic(run_dir / ERROR_FILE, (message or type(exc).__name__) + "\n")
         raise
-    wall = time.perf_counter() - t0
-    for label, seconds in sorted(ctx.timings.items()):
-        ds[f"time_{label}"] = ((), seconds, {"long_name": f"wall time of {label}", "units": "s"})
-    references = getattr(type(study), "references", {}) or {}
-    attrs = {
-        "Conventions": "CF-1.10",
-        "title": config.get("title") or ds.attrs.get("title") or f"pointatlas {experiment}",
-        "source": source_attr(plugins),
-        "history": f"{start}: {command_line()}",
-        "config": config_yaml,
-        "overrides": list(overrides),
-        "git_commit": commit,
-        "seed": seed,
-        "hostname": hostname(),
-        "wall_time_s": wall,
-        "status": "completed",
-        "start_time": start,
-        "end_time": now_iso(),
-        "run_id": run_id,
-        "experiment": experiment,
-        "study": plugins["study"],
-        "plugins": plugins,
-        "metrics": metric_names(ds),
-        "references": references,
-    }
-    path = write_results(ds, run_dir / RESULTS_NAME, attrs)
-    metrics = metric_values(ds)
-    catalog.finish(run_id, status="completed", end_time=attrs["end_time"], wall_time_s=wall,
-                   metrics=metrics)
+    record.completed(wall_time_s=wall, metrics=metrics)
     shown = ", ".join(f"{k}={v:.6g}" for k, v in metrics.items() if not k.startswith("time_"))
     log.info("run %s completed in %.2f s: %s", run_id, wall, shown)
     log.info("results: %s", path)

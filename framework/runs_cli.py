@@ -6,6 +6,11 @@ Subcommands::
                          [--metric 'name<value' ...] [--format table|json] [--limit N]
     pointatlas-runs show ID [--format table|json]
     pointatlas-runs compare ID ID [...] [--format table|json]
+    pointatlas-runs repair            rebuild the catalog from the run directories
+    pointatlas-runs gc                remove the temporary files killed writes left behind
+
+A run recorded as running whose process is gone (killed, out of memory, a lost node) is
+listed as ``died``.
 
 The outputs root is ``--root``, else the environment variable ``POINTATLAS_OUTPUTS``, else
 ``./outputs``; the catalog is ``<root>/catalog.sqlite``. Errors print one line to stderr and
@@ -23,7 +28,8 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Sequence
 
-from .catalog import METRIC_SYNTAX, STATUSES, MISSING, WHERE_SYNTAX, Catalog, RunRecord, catalog_path
+from .catalog import (DIED, METRIC_SYNTAX, MISSING, STATUSES, WHERE_SYNTAX, Catalog, RunRecord,
+                      catalog_path)
 from .errors import PointatlasError
 
 PROG = "pointatlas-runs"
@@ -49,12 +55,14 @@ def build_parser() -> argparse.ArgumentParser:
     common.add_argument("--root", default=argparse.SUPPRESS,
                         help=f"outputs root holding catalog.sqlite (default: ${ENV_ROOT} or ./outputs)")
     common.add_argument("--format", choices=("table", "json"), default="table", help="output format")
-    sub = parser.add_subparsers(dest="command", metavar="{list,show,compare}", parser_class=_Parser)
+    sub = parser.add_subparsers(dest="command", metavar="{list,show,compare,repair,gc}",
+                                parser_class=_Parser)
     sub.required = True
 
     listing = sub.add_parser("list", parents=[common], help="list runs (oldest first)")
     listing.add_argument("--experiment", help="only runs of this experiment")
-    listing.add_argument("--status", choices=(*STATUSES, MISSING), help="only runs with this status")
+    listing.add_argument("--status", choices=(*STATUSES, MISSING, DIED),
+                         help="only runs with this status")
     listing.add_argument("--where", action="append", default=[], metavar="KEY=VALUE",
                          help=f"override/param filter, repeatable: {WHERE_SYNTAX}")
     listing.add_argument("--metric", action="append", default=[], metavar="EXPR",
@@ -67,6 +75,10 @@ def build_parser() -> argparse.ArgumentParser:
 
     compare = sub.add_parser("compare", parents=[common], help="runs side by side")
     compare.add_argument("run_ids", metavar="ID", nargs="+", help="two or more run ids or prefixes")
+    sub.add_parser("repair", parents=[common], help="move a damaged catalog aside and rebuild "
+                   "it from the results.nc / run.json files under the root")
+    sub.add_parser("gc", parents=[common], help="remove the temporary files (.results.nc.*.tmp, "
+                   "*.partial.nc) that killed writes left in run directories")
     return parser
 
 
@@ -79,8 +91,12 @@ def main(argv: Sequence[str] | None = None) -> int:
             return int(exc.code or 0)
         if args.command == "compare" and len(args.run_ids) < 2:
             raise _UsageError("compare needs at least two run ids")
-        catalog = _open_catalog(_root(args.root))
-        output = {"list": _cmd_list, "show": _cmd_show, "compare": _cmd_compare}[args.command](catalog, args)
+        if args.command in ("repair", "gc"):
+            output = _cmd_repair(args) if args.command == "repair" else _cmd_gc(args)
+        else:
+            catalog = _open_catalog(_root(args.root))
+            output = {"list": _cmd_list, "show": _cmd_show,
+                      "compare": _cmd_compare}[args.command](catalog, args)
         sys.stdout.write(output if output.endswith("\n") else output + "\n")
         sys.stdout.flush()
         return 0
@@ -91,7 +107,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         _fail(str(exc))
         return 1
     except sqlite3.Error as exc:
-        _fail(f"cannot read the catalog: {exc}")
+        _fail(f"cannot read the catalog {catalog_path(_root(getattr(args, 'root', None)))}: {exc}. "
+              f"Fix: `{PROG} repair` rebuilds it from the run directories.")
         return 1
     except BrokenPipeError:
         _silence_stdout()
@@ -166,6 +183,8 @@ def _cmd_show(catalog: Catalog, args: argparse.Namespace) -> str:
         ("start", record.start_time or "-"), ("end", record.end_time or "-"),
         ("wall time", _duration(record.wall_time_s)), ("path", record.path or "-"),
         ("git commit", record.git_commit or "-"), ("error", record.error or "-"),
+        ("process", f"{record.pid} on {record.host}" if record.pid else "-"),
+        ("heartbeat", record.heartbeat or "-"),
     ]
     width = max(len(k) for k, _ in lines)
     out = [f"{k:<{width}}  {v}" for k, v in lines]
@@ -216,6 +235,34 @@ def _cmd_compare(catalog: Catalog, args: argparse.Namespace) -> str:
                             for n, vals in metrics.items()])
                     if metrics else "metrics: none")
     return "\n\n".join(sections)
+
+
+def _cmd_repair(args: argparse.Namespace) -> str:
+    from .catalog_repair import rebuild_catalog
+
+    root = _root(args.root)
+    if not root.is_dir():
+        raise PointatlasError(f"no outputs root at {root}: pass --root <the outputs_root of your runs>")
+    report = rebuild_catalog(root)
+    if args.format == "json":
+        return _json({"catalog": str(catalog_path(root)), "moved_aside": list(map(str, report.moved_aside)),
+                      "completed": report.completed, "failed": report.failed,
+                      "unfinished": report.unfinished,
+                      "unreadable": list(map(str, report.unreadable))})
+    return report.text(catalog_path(root))
+
+
+def _cmd_gc(args: argparse.Namespace) -> str:
+    from .catalog_repair import collect_garbage
+
+    root = _root(args.root)
+    if not root.is_dir():
+        raise PointatlasError(f"no outputs root at {root}: pass --root <the outputs_root of your runs>")
+    removed = collect_garbage(root)
+    if args.format == "json":
+        return _json({"removed": list(map(str, removed))})
+    return f"removed {len(removed)} leftover temporary files under {root}" + "".join(
+        f"\n  {p}" for p in removed)
 
 
 # ----------------------------------------------------------------------------- formatting

@@ -43,6 +43,36 @@ def check_contract(cls: type) -> None:
         assert hasattr(obj, key) and _same(getattr(obj, key), value), (
             f"{name}.__init__ must store {key!r} unchanged (scikit-learn convention)")
     _check_hydra(config, name)
+    check_refuses_bad_values(cls, defaults)
+
+
+def check_refuses_bad_values(cls: type, defaults: dict) -> None:
+    """A bad value is refused with :class:`pointatlas.ConfigError` or ``ValueError``.
+
+    For each float setting, the plugin is built with NaN there; its ``__init__`` and its
+    ``check_config()`` (the start-up check the run pipeline calls before any work, see
+    :mod:`pointatlas.config_check`) may raise only ``ValueError`` (ConfigError is one), and a
+    plugin that has ``check_config`` must refuse the NaN: no parameter of a plugin is
+    meaningful as NaN.
+    """
+    name = cls.__name__
+    for key, value in defaults.items():
+        if isinstance(value, bool) or not isinstance(value, float):
+            continue
+        try:
+            plugin = cls(**{**defaults, key: float("nan")})
+            check = getattr(plugin, "check_config", None)
+            if callable(check):
+                check()
+        except ValueError:
+            continue
+        except Exception as exc:  # noqa: BLE001 - the wrong kind of refusal is the failure
+            raise AssertionError(
+                f"{name} with {key}=nan raised {type(exc).__name__} ({exc}); refuse bad values "
+                "with pointatlas.ConfigError (or ValueError) naming the key and the fix") from exc
+        assert not callable(getattr(cls, "check_config", None)), (
+            f"{name}.check_config() accepts {key}=nan; check that {key} is a finite number in "
+            "its valid range and raise pointatlas.ConfigError naming it and the fix")
 
 
 def _same(a, b) -> bool:

@@ -87,6 +87,14 @@ class SurfaceSource:
                 "(one refinement level coarser).",
             )
 
+    def check_config(self) -> None:
+        """The checks that need no sampling (run at start-up, before any work)."""
+        self._check_common()
+        check_model = getattr(self, "_check_model", None)
+        if callable(check_model):
+            check_model()
+        self._check()
+
     def load(self, rng: np.random.Generator) -> PointCloud:
         """Sample the surface; all randomness comes from ``rng``."""
         check_rng(rng)

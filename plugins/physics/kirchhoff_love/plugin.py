@@ -25,6 +25,10 @@ class KirchhoffLove:
     def settings(self) -> ShellSettings:
         return ShellSettings(**{k: getattr(self, k) for k in ShellSettings.__dataclass_fields__})
 
+    def check_config(self) -> None:
+        """The checks of :meth:`shell_settings`, at start-up (before any work)."""
+        self.shell_settings()
+
     def shell_settings(self) -> ShellSettings:
         """The settings with supports, loads and selectors as dataclasses, checked."""
         s = _as_settings(self.settings())

@@ -1,6 +1,7 @@
 """Read a point set from a file: .npz, .ply, .vtk/.vtp/.vtu, .csv/.txt."""
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import ClassVar, Optional
@@ -16,7 +17,11 @@ SUFFIXES = (".npz", *MESH_SUFFIXES, *TEXT_SUFFIXES)
 
 
 def read_npz(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
-    """Array ``points`` (N, D) and, if present, ``markers`` (M, D) from a .npz archive."""
+    """Array ``points`` (N, D) and, if present, ``markers`` (M, D) from a .npz archive.
+
+    Both must hold numbers (integer or floating dtype); an array of strings, booleans or
+    objects is refused with its key and dtype named.
+    """
     try:
         with np.load(path, allow_pickle=False) as data:
             if "points" not in data.files:
@@ -24,28 +29,82 @@ def read_npz(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
                     f"{path} has no array named 'points' (arrays: {sorted(data.files)}). "
                     "Save it with numpy.savez(path, points=X) where X has shape (n_points, n_dims)."
                 )
-            points = np.array(data["points"])
-            markers = np.array(data["markers"]) if "markers" in data.files else None
+            arrays = {key: np.array(data[key]) for key in ("points", "markers")
+                      if key in data.files}
     except InputError:
         raise
     except Exception as exc:  # noqa: BLE001 - any read failure is the user's file
         raise InputError(f"cannot read {path} as .npz ({type(exc).__name__}: {exc}). "
                          "Write it with numpy.savez(path, points=X).") from exc
-    return points, markers
+    for key, array in arrays.items():
+        if array.dtype.kind not in "iuf":
+            raise InputError(
+                f"{path}: array '{key}' has dtype {array.dtype} "
+                f"({_KIND_NAMES.get(array.dtype.kind, 'not numbers')}); coordinates must be "
+                "numbers. Save float coordinates with "
+                f"numpy.savez(path, {key}=X.astype(float)), X of shape (n_points, n_dims).")
+    return arrays["points"], arrays.get("markers")
+
+
+#: what a non-numeric dtype kind holds (numpy ``dtype.kind`` codes)
+_KIND_NAMES = {"U": "text", "S": "bytes", "O": "Python objects", "b": "booleans",
+               "c": "complex numbers", "M": "dates", "m": "time spans", "V": "records"}
 
 
 def read_mesh_points(path: Path) -> np.ndarray:
-    """The points of a dataset read with pyvista (.ply, .vtk, .vtp, .vtu, .stl, .obj)."""
+    """The points of a dataset read with pyvista (.ply, .vtk, .vtp, .vtu, .stl, .obj).
+
+    VTK's own output is silenced while reading (its log, its output window and pyvista's
+    re-logging of it): a file VTK cannot parse is one :class:`InputError` naming the file,
+    the format and VTK's first message.
+    """
+    import logging
+    import warnings
+
     import pyvista  # lazy: heavy import
 
+    fmt = path.suffix.lower().lstrip(".").upper()
+    root = logging.getLogger()
+    root.addFilter(_drop_record)  # pyvista sends VTK errors to the root logger
     try:
-        dataset = pyvista.read(str(path))
-    except Exception as exc:  # noqa: BLE001
-        raise InputError(f"cannot read {path} with pyvista ({type(exc).__name__}: {exc}). "
-                         "Check that the file is a valid VTK/PLY dataset.") from exc
+        with pyvista.vtk_verbosity("off"), warnings.catch_warnings(), \
+                pyvista.VtkErrorCatcher(send_to_logging=False) as caught:
+            warnings.simplefilter("ignore")
+            try:
+                dataset = pyvista.get_reader(str(path)).read()
+            except Exception as exc:  # noqa: BLE001 - any failure is the user's file
+                raise InputError(
+                    f"{path} could not be parsed as {fmt} ({_vtk_reason(exc)}). Check that the "
+                    f"file is a valid {fmt} dataset, or save the points with "
+                    "numpy.savez(name + '.npz', points=X).") from None
+    finally:
+        root.removeFilter(_drop_record)
     if isinstance(dataset, pyvista.MultiBlock):
         dataset = dataset.combine()
-    return np.array(dataset.points, dtype=np.float64)
+    points = np.array(dataset.points, dtype=np.float64)
+    # a VTK error means the file was not read (a warning alone, with points, is kept)
+    messages = [e.alert for e in (*caught.warning_events, *caught.error_events)]
+    if caught.error_events or (messages and len(points) == 0):
+        raise InputError(
+            f"{path} could not be parsed as {fmt} (VTK: {_vtk_reason(messages[0])}). Check "
+            f"that the file is a valid {fmt} dataset, or save the points with "
+            "numpy.savez(name + '.npz', points=X).")
+    return points
+
+
+def _drop_record(record) -> bool:  # noqa: ARG001 - the logging filter interface
+    """A logging filter that drops every record (installed only while VTK reads a file)."""
+    return False
+
+
+def _vtk_reason(message) -> str:
+    """The informative part of a VTK message: its first line that is not a source location,
+    without the ``vtkClass (0x...):`` prefix."""
+    lines = [line.strip() for line in str(message).splitlines() if line.strip()]
+    lines = [line for line in lines if not re.match(r"(ERROR|WARNING|Warning|Error): In ", line)]
+    if not lines:
+        return type(message).__name__
+    return re.sub(r"^\w+ \(0x[0-9a-fA-F]+\): ", "", lines[0])
 
 
 def read_text(path: Path) -> np.ndarray:
@@ -61,6 +120,26 @@ def read_text(path: Path) -> np.ndarray:
     raise InputError(f"cannot parse {path} as a table of numbers ({last}). Write one point "
                      "per line, coordinates separated by "
                      f"{'commas' if delimiter else 'spaces'}, at most one header line.")
+
+
+def check_readable_file(path: Path) -> None:
+    """Refuse, with the fix, a path that is missing, a directory, empty (0 bytes) or unreadable."""
+    if path.is_dir():
+        raise InputError(f"{path} is a directory, not a file of points. Give a file in it, "
+                         f"e.g. source.path={path / 'points.npz'}.")
+    if not path.is_file():
+        raise InputError(f"{path}: no such file. Check the path (relative paths are "
+                         f"resolved from the working directory {Path.cwd()}).")
+    try:
+        with open(path, "rb") as f:
+            f.read(1)
+    except OSError as exc:
+        raise InputError(f"{path} cannot be read ({exc.strerror or type(exc).__name__}). Make "
+                         f"it readable (chmod u+r {path}) or copy it somewhere you can read."
+                         ) from None
+    if path.stat().st_size == 0:
+        raise InputError(f"{path} is empty (0 bytes): it holds no points. Check that the file "
+                         "was written completely, or give another file.")
 
 
 class PointFile:
@@ -101,6 +180,28 @@ class PointFile:
         self.n_points = n_points
         self.subsample = subsample
 
+    def check_config(self) -> Path:
+        """The checks that need no reading (run at start-up): the path names a readable,
+        non-empty file of a known format; ``subsample`` and ``n_points`` are valid."""
+        if not isinstance(self.path, (str, Path)) or str(self.path) in ("", "???"):
+            raise ConfigError("path is missing: the 'file' source needs path=<file with points>, "
+                              "e.g. source.path=data/points.npz on the command line.")
+        path = Path(self.path).expanduser()
+        suffix = path.suffix.lower()
+        if suffix not in SUFFIXES:
+            raise InputError(f"{path}: unknown file extension {suffix!r}. Supported: "
+                             f"{', '.join(SUFFIXES)}; convert the file, e.g. save "
+                             "numpy.savez(name + '.npz', points=X).")
+        check_readable_file(path)
+        if self.subsample not in ("farthest", "random"):
+            raise ConfigError(f"subsample={self.subsample!r} is invalid: use 'farthest' "
+                              "(quasi-uniform subset) or 'random' (seeded random subset).")
+        n = self.n_points
+        if n is not None and (not isinstance(n, (int, np.integer)) or isinstance(n, bool)
+                              or n < 1):
+            raise ConfigError(f"n_points={n!r} is invalid: must be None or an integer >= 1.")
+        return path
+
     def load(self, rng: np.random.Generator | None = None) -> PointCloud:
         """Read the file; keep ``n_points`` of them if the file has more.
 
@@ -111,18 +212,8 @@ class PointFile:
         20 000 random ones give 1.3 % (README, "Known limits"). ``'random'`` keeps a seeded
         random subset.
         """
-        if not isinstance(self.path, (str, Path)) or str(self.path) in ("", "???"):
-            raise ConfigError("path is missing: the 'file' source needs path=<file with points>, "
-                              "e.g. source.path=data/points.npz on the command line.")
-        path = Path(self.path).expanduser()
+        path = self.check_config()
         suffix = path.suffix.lower()
-        if suffix not in SUFFIXES:
-            raise InputError(f"{path}: unknown file extension {suffix!r}. Supported: "
-                             f"{', '.join(SUFFIXES)}; convert the file, e.g. save "
-                             "numpy.savez(name + '.npz', points=X).")
-        if not path.is_file():
-            raise InputError(f"{path}: no such file. Check the path (relative paths are "
-                             f"resolved from the working directory {Path.cwd()}).")
         markers = None
         if suffix == ".npz":
             points, markers = read_npz(path)
@@ -130,6 +221,10 @@ class PointFile:
             points = read_mesh_points(path)
         else:
             points = read_text(path)
+        if np.shape(points)[0] == 0:
+            raise InputError(f"{path} holds no points. Give a file with at least one "
+                             "point, e.g. numpy.savez(path, points=X) with X of shape "
+                             "(n_points, n_dims).")
         points = validate_points(points, what=f"points of {path}")
         if markers is not None:
             markers = validate_points(markers, what=f"markers of {path}")
@@ -137,13 +232,8 @@ class PointFile:
         if d is not None and not (isinstance(d, (int, np.integer)) and 1 <= d <= points.shape[1]):
             raise ConfigError(f"intrinsic_dim={d!r} is invalid: must be None or an integer in "
                               f"[1, {points.shape[1]}] (the ambient dimension of {path}).")
-        if self.subsample not in ("farthest", "random"):
-            raise ConfigError(f"subsample={self.subsample!r} is invalid: use 'farthest' "
-                              "(quasi-uniform subset) or 'random' (seeded random subset).")
         n = self.n_points
         if n is not None:
-            if not isinstance(n, (int, np.integer)) or n < 1:
-                raise ConfigError(f"n_points={n!r} is invalid: must be None or an integer >= 1.")
             if n < len(points):
                 rng = rng if rng is not None else np.random.default_rng(0)
                 if self.subsample == "farthest":

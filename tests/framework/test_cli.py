@@ -77,11 +77,12 @@ def test_wrong_type_is_named(tmp_path, run_cli):
 
 def test_missing_input_file_is_a_clear_failure_recorded_in_catalog(tmp_path, run_cli):
     proc = run_cli("pointatlas", "source=file", f"source.path={tmp_path}/nope.npz", cwd=tmp_path)
-    assert proc.returncode == 1
+    assert proc.returncode == 2  # refused at start-up: no run directory
     assert "nope.npz" in proc.stderr and "Traceback" not in proc.stderr
     rows = catalog_rows(tmp_path / "outputs")
     assert rows[0]["status"] == "failed" and "nope.npz" in rows[0]["error"]
     assert not list((tmp_path / "outputs").rglob("results.nc"))
+    assert not (tmp_path / "outputs" / "runs").exists()
 
 
 def test_third_party_plugin_runs_by_name(tmp_path, run_cli):

@@ -37,6 +37,15 @@ class EmbedderBase:
             k = getattr(self, "n_neighbors", None) or 12
         return check_int("aic_neighbors", k, low=1, fix="Typical value: 12.")
 
+    def estimated_bytes(self, n_points: int, ambient_dim: int) -> int:
+        """Bytes ``fit`` needs for ``n_points`` points in R^ambient_dim, to refuse a too-large
+        request before starting: here the input, the output and a k-NN graph (weights and
+        indices, both directions), 8 (D + d + 4k) N. Embedders with dense N x N work override it.
+        """
+        k = getattr(self, "n_neighbors", None) or 12
+        d = getattr(self, "n_components", 2)
+        return 8 * int(n_points) * (int(ambient_dim) + int(d) + 4 * int(k))
+
     def _embed(self, X: np.ndarray) -> np.ndarray:  # pragma: no cover - abstract
         raise NotImplementedError
 

@@ -84,6 +84,11 @@ class Isomap(EmbedderBase):
         self.aic = aic
         self.aic_neighbors = aic_neighbors
 
+    def estimated_bytes(self, n_points: int, ambient_dim: int) -> int:
+        """Bytes of Isomap on N points: the dense N x N geodesic distance matrix (overwritten
+        in place by classical MDS), 8 N², plus the graph and the output (EmbedderBase)."""
+        return 8 * int(n_points) ** 2 + super().estimated_bytes(n_points, ambient_dim)
+
     def _embed(self, X) -> np.ndarray:
         X = check_points(X, min_points=2)
         check_graph_params(self.n_neighbors, self.radius, X.shape[0])

@@ -30,8 +30,35 @@ from __future__ import annotations
 
 import numpy as np
 
+from pointatlas.errors import InputError
+
 from .geodesics import all_geodesic_distances, geodesic_neighbors
 from .neighbor_graph import connected_neighbor_graph
+
+
+def min_points(measure: str, n_neighbors: int) -> int:
+    """Fewest points for which ``measure`` with ``n_neighbors`` = k is defined.
+
+    'stress', 'residual_variance', 'reconstruction_error': k other points per point, N >= k + 1.
+    'trustworthiness': k < N / 2, N >= 2k + 1 (scikit-learn's bound; the normalisation
+    2 / (N k (2N - 3k - 1)) of Venna & Kaski needs at least 3k + 1 < 2N).
+    """
+    k = int(n_neighbors)
+    if measure == "trustworthiness":
+        return 2 * k + 1
+    if measure in ("stress", "residual_variance", "reconstruction_error"):
+        return k + 1
+    raise ValueError(f"unknown quality measure {measure!r}")
+
+
+def check_enough_points(measure: str, n_points: int, n_neighbors: int) -> None:
+    """Raise :class:`InputError` when ``n_points`` are too few for ``measure`` (see min_points)."""
+    need = min_points(measure, n_neighbors)
+    if n_points < need:
+        rule = "2 n_neighbors + 1" if measure == "trustworthiness" else "n_neighbors + 1"
+        raise InputError(
+            f"{measure} with n_neighbors={n_neighbors} needs at least {need} points ({rule}), "
+            f"got {n_points}. Give more points or lower n_neighbors.")
 
 
 def stress_on_pairs(Y: np.ndarray, idx: np.ndarray, dist: np.ndarray) -> float:
@@ -53,6 +80,7 @@ def stress(Y, X, n_neighbors: int = 12, *, graph_neighbors: int | None = None) -
     """
     Y = np.asarray(Y, float)
     X = np.asarray(X, float)
+    check_enough_points("stress", X.shape[0], max(n_neighbors, graph_neighbors or 0))
     G = connected_neighbor_graph(X, graph_neighbors or n_neighbors)
     idx, dist = geodesic_neighbors(G, n_neighbors)
     return stress_on_pairs(Y, idx, dist)
@@ -62,6 +90,7 @@ def trustworthiness(Y, X, n_neighbors: int = 5) -> float:
     """Trustworthiness in [0, 1] of ``Y`` w.r.t. ``X`` (Venna & Kaski), via scikit-learn."""
     from sklearn.manifold import trustworthiness as _tw
 
+    check_enough_points("trustworthiness", len(X), n_neighbors)
     return float(_tw(np.asarray(X, float), np.asarray(Y, float), n_neighbors=n_neighbors))
 
 
@@ -70,6 +99,7 @@ def residual_variance(Y, X, n_neighbors: int = 12) -> float:
     from scipy.spatial.distance import pdist
 
     X = np.asarray(X, float)
+    check_enough_points("residual_variance", X.shape[0], n_neighbors)
     D = all_geodesic_distances(connected_neighbor_graph(X, n_neighbors))
     iu = np.triu_indices(X.shape[0], 1)
     r = np.corrcoef(D[iu], pdist(np.asarray(Y, float)))[0, 1]
@@ -87,6 +117,7 @@ def reconstruction_error(Y, X, n_neighbors: int = 12, reg: float = 1e-3) -> floa
 
     X = np.asarray(X, float)
     Y = np.asarray(Y, float)
+    check_enough_points("reconstruction_error", Y.shape[0], n_neighbors)
     _, nb = cKDTree(Y).query(Y, n_neighbors + 1)
     nb = nb[:, 1:]
     Z = Y[nb] - Y[:, None, :]                          # (N, k, d)

@@ -76,12 +76,16 @@ class EmbeddingComparison:
 
         from pointatlas.errors import ConfigError
 
+        from .embedding import check_embedding_memory
+
         names = list(self.embedders or self.Config().embedders)
         if not names:
             raise ConfigError("study.embedders is empty: list at least one embedder, e.g. [pca,isomap].")
         with ctx.timed("source"):
             cloud = ctx.plugin("source").load(ctx.rng("source"))
         X = cloud.points
+        for name in names:  # refuse a dense embedder too large for memory before any work
+            check_embedding_memory(self._embedder(ctx, name), name, len(X), X.shape[1])
         with ctx.timed("geodesics"):
             pairs = geodesic_neighbors(connected_neighbor_graph(X, self.n_neighbors), self.n_neighbors)
         stages = ["raw", "aic"] if self.aic else ["raw"]

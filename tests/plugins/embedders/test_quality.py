@@ -1,4 +1,5 @@
 import numpy as np
+import pytest
 
 from pointatlas_embedders.quality import (reconstruction_error, residual_variance, stress,
                                           stress_on_pairs, trustworthiness)
@@ -27,3 +28,18 @@ def test_scaled_plane_stress_is_known():
     assert residual_variance(Y[:, ::-1] * [1, 3], X, 8) > 0.1
     assert reconstruction_error(Y, X, 8) < 1e-3
     assert reconstruction_error(rng.random((200, 2)), X, 8) > 0.05
+
+
+@pytest.mark.parametrize("measure, need", [("stress", 13), ("trustworthiness", 25),
+                                           ("residual_variance", 13),
+                                           ("reconstruction_error", 13)])
+def test_too_few_points_for_the_neighbourhood_is_an_input_error(measure, need):
+    import pointatlas_embedders.quality as quality
+    from pointatlas.errors import InputError
+
+    X = np.random.default_rng(0).normal(size=(need - 1, 3))
+    with pytest.raises(InputError, match=rf"{measure} with n_neighbors=12 needs at least {need} "
+                                         rf"points .* got {need - 1}\. Give more points"):
+        getattr(quality, measure)(X[:, :2], X, n_neighbors=12)
+    X = np.random.default_rng(0).normal(size=(need, 3))
+    assert np.isfinite(getattr(quality, measure)(X[:, :2], X, n_neighbors=12))

@@ -18,6 +18,7 @@ from scipy.spatial import cKDTree
 from pointatlas.errors import InputError
 
 from . import differential_geometry as dg
+from . import memory_estimate as mem
 from .settings import AtlasSettings
 from .chart import Chart, ChartQuadrature, build_chart, chart_quadrature
 from .quadrature import simplex_rule
@@ -114,8 +115,24 @@ class Atlas:
         return (defects["flip_fraction"] == 0.0 and defects["stress"] < s.max_stress
                 and defects["distortion"] < s.max_distortion)
 
-    def partition(self, points: np.ndarray, markers: Optional[np.ndarray] = None) -> np.ndarray:
-        """Partition the markers (default: the points) and fit the PU. Returns labels (M,)."""
+    def estimated_bytes(self, n_points: int, n_markers: int, ambient_dim: int, chart_dim: int,
+                        keep_basis: bool = False) -> int:
+        """Bytes the built atlas will hold (:func:`memory_estimate.estimate_atlas_bytes` with
+        the supports of these settings' LME charts and Shepard partition of unity)."""
+        s = self.settings
+        return mem.estimate_atlas_bytes(
+            n_points, ambient_dim, chart_dim, mem.support_size(chart_dim, s.gamma_lme, s.tol_lme),
+            pu_support_size=mem.support_size(chart_dim, s.gamma_pu, s.tol_pu),
+            quadrature_order=s.quadrature_order, n_markers=n_markers,
+            margin=s.margin_for(chart_dim), keep_basis=keep_basis)
+
+    def partition(self, points: np.ndarray, markers: Optional[np.ndarray] = None, *,
+                  keep_basis: bool = False) -> np.ndarray:
+        """Partition the markers (default: the points) and fit the PU. Returns labels (M,).
+
+        First refuses (InputError) an atlas whose estimated memory does not fit the memory
+        available; ``keep_basis``: the quadrature will keep the basis functions (counted).
+        """
         s = self.settings
         s.check()
         P = np.asarray(points, dtype=np.float64)
@@ -123,12 +140,13 @@ class Atlas:
         if P.ndim != 2 or Q.ndim != 2 or Q.shape[1] != P.shape[1]:
             raise InputError(f"points {P.shape} and markers {Q.shape} must be (n, D) arrays "
                              "with the same D.")
+        # the chart dimension d, for d-dependent defaults (the embedders' n_components)
+        self.chart_dim_ = int(getattr(self.make_embedder(), "n_components", 2))
+        self._check_memory(P.shape[0], Q.shape[0], P.shape[1], keep_basis)
         self.points_, self.markers_ = P, Q
         self.point_tree_ = cKDTree(P)
         self._control_sets, self._embeddings, self._margin_csr = {}, {}, None
         self.h_points_ = float(np.median(self.point_tree_.query(P, k=2)[0][:, 1]))
-        # the chart dimension d, for d-dependent defaults (the embedders' n_components)
-        self.chart_dim_ = int(getattr(self.make_embedder(), "n_components", 2))
         self.pu_ = self.make_pu().fit(Q)
         self.W_points_ = self.pu_.evaluate(P, order=0).to_csr(Q.shape[0]).tocsc()
         n_parts = s.n_patches or max(1, int(round(Q.shape[0] / s.markers_per_patch)))
@@ -138,6 +156,20 @@ class Atlas:
         self.labels_, self.accepted_ = refine_partition(
             labels, self.adjacency_, self._acceptable, max_depth=s.max_refinement_depth)
         return self.labels_
+
+    def _check_memory(self, n_points: int, n_markers: int, ambient_dim: int,
+                      keep_basis: bool) -> None:
+        """Refuse, before any work, an atlas that cannot fit in memory (one line, with fix)."""
+        needed = self.estimated_bytes(n_points, n_markers, ambient_dim, self.chart_dim_,
+                                      keep_basis)
+        available, _ = mem.available_memory_bytes()
+        # the estimate is linear in N; the suggested size leaves 10 % of the memory free
+        fitting = max(1, int(n_points * min(1.0, available / max(needed, 1)) * 0.9))
+        mem.check_memory(
+            needed, f"an atlas of {n_points} points in R^{ambient_dim} (charts of dimension "
+                    f"{self.chart_dim_}, quadrature order {self.settings.quadrature_order})",
+            f"Use fewer points (e.g. source.n_points={fitting}, memory grows in proportion), a "
+            "lower study.quadrature_order, or a machine with more memory.")
 
     def refinement_warning(self) -> Optional[str]:
         """Why the atlas may be wrong, if patches still fail the chart test after

@@ -83,7 +83,7 @@ def build_model(cloud, settings, atlas_settings, make_embedder, make_lme, make_p
     markers = cloud.markers if cloud.markers is not None else P
     atlas = Atlas(atlas_settings, make_embedder, make_lme, make_pu)
     with _timed(times, "partition"):
-        atlas.partition(nodes, markers)
+        atlas.partition(nodes, markers, keep_basis=True)
     warning = atlas.refinement_warning()
     if warning and log is not None:
         log.warning(warning)

@@ -42,7 +42,7 @@ SCHEMA_VERSION = 2
 CATALOG_FILENAME = "catalog.sqlite"
 #: Statuses stored in the catalog; "missing" is computed when the run directory is gone, and
 #: "died" for a run recorded as running whose process no longer exists.
-STATUSES = ("running", "completed", "failed")
+STATUSES = ("running", "completed", "completed_with_warnings", "failed")
 
 
 _SCHEMA = """
@@ -143,8 +143,9 @@ class Catalog:
     def finish(self, run_id: str, *, status: str, end_time: str, wall_time_s: float,
                metrics: dict[str, float], error: str | None = None) -> None:
         """Record the end of a started run: status ("completed"/"failed"), time and metrics."""
-        if status not in ("completed", "failed"):
-            raise ConfigError(f"finish status {status!r} is invalid: use 'completed' or 'failed'")
+        if status not in ("completed", "completed_with_warnings", "failed"):
+            raise ConfigError(f"finish status {status!r} is invalid: use 'completed', "
+                              "'completed_with_warnings' or 'failed'")
         values = _metric_rows(metrics)
 
         def write(conn: sqlite3.Connection) -> None:

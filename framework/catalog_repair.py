@@ -60,6 +60,8 @@ def _results_facts(path: Path) -> dict:
         "git_commit": str(attrs.get("git_commit", "")),
         "start_time": str(attrs.get("start_time", "")), "end_time": str(attrs.get("end_time", "")),
         "wall_time_s": float(attrs.get("wall_time_s", float("nan"))), "metrics": metrics,
+        "status": "completed_with_warnings" if str(attrs.get("status")) ==
+        "completed_with_warnings" else "completed",
     }
 
 
@@ -91,7 +93,7 @@ def _copy(catalog: Catalog, record) -> None:
                   start_time=record.start_time or "", params=record.params,
                   process={"pid": record.pid, "host": record.host, "pid_start": record.pid_start}
                   if record.pid else None)
-    if record.recorded_status in ("completed", "failed"):
+    if record.recorded_status in ("completed", "completed_with_warnings", "failed"):
         catalog.finish(record.id, status=record.recorded_status, end_time=record.end_time or "",
                        wall_time_s=record.wall_time_s if record.wall_time_s is not None
                        else float("nan"), metrics=record.metrics, error=record.error)
@@ -129,7 +131,7 @@ def rebuild_catalog(root: str | Path) -> RepairReport:
                               overrides=facts["overrides"], path=str(run_dir),
                               git_commit=facts["git_commit"], start_time=facts["start_time"],
                               params=facts["params"])
-                catalog.finish(facts["run_id"], status="completed", end_time=facts["end_time"],
+                catalog.finish(facts["run_id"], status=facts["status"], end_time=facts["end_time"],
                                wall_time_s=facts["wall_time_s"], metrics=facts["metrics"])
                 report.completed += 1
                 continue

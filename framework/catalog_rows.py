@@ -23,7 +23,7 @@ DIED = "died"
 class RunRecord:
     """One run as recorded in the catalog.
 
-    ``status`` is "running", "completed" or "failed"; "missing" when the recorded run
+    ``status`` is "running", "completed", "completed_with_warnings" or "failed"; "missing" when the recorded run
     directory no longer exists, "died" when a run recorded as running has no live process
     (the stored status is kept in ``recorded_status``).
     Times are ISO 8601 strings (UTC), ``wall_time_s`` in seconds; ``metrics`` maps metric

@@ -171,6 +171,53 @@ def _task(cfg) -> None:
     )
 
 
+def chosen_plugins(overrides: list[str]) -> dict[str, str]:
+    """family -> plugin chosen on the command line (``source=file``), sweeps excluded."""
+    out = {}
+    for override in overrides:
+        key, sep, value = override.partition("=")
+        if sep and key in FAMILIES.values() and value and "," not in value and value != "null":
+            out[key] = value
+    return out
+
+
+def _log_dropped_experiment_settings(overrides: list[str], chosen: dict[str, str]) -> None:
+    """Say which of the experiment's settings do not apply to a plugin chosen instead."""
+    from omegaconf import OmegaConf
+
+    from .config import experiment_settings_for, experiments
+
+    name = next((o.split("=", 1)[1] for o in overrides if o.startswith("experiment=")),
+                None if "~experiment" in overrides else _default_experiment())
+    path = experiments().get(name or "")
+    if path is None or not chosen:
+        return
+    node = OmegaConf.load(path)
+    for family, plugin in chosen.items():
+        block = node.get(family)
+        if block is None or not OmegaConf.is_dict(block):
+            continue
+        _, dropped = experiment_settings_for(family, plugin,
+                                             OmegaConf.to_container(block, resolve=False))
+        given = {o.split("=", 1)[0].lstrip("+") for o in overrides}
+        dropped = {k: v for k, v in dropped.items() if f"{family}.{k}" not in given}
+        if dropped:
+            shown = ", ".join(f"{family}.{k}={v}" for k, v in dropped.items())
+            print(f"pointatlas: experiment {name} sets {shown} for its own {family}; not applied "
+                  f"to {family}={plugin} (set them on the command line to apply them).",
+                  file=sys.stderr)
+
+
+def _default_experiment() -> str | None:
+    """The experiment conf/config.yaml selects when the command line names none."""
+    from omegaconf import OmegaConf
+
+    for entry in OmegaConf.load(CONF_DIR / "config.yaml").get("defaults", []):
+        if OmegaConf.is_dict(entry) and "experiment" in entry:
+            return entry["experiment"]
+    return None
+
+
 def _job_run_id() -> str | None:
     from .sweep_guard import JOB
 
@@ -212,8 +259,10 @@ def main(argv: list[str] | None = None) -> None:
     _EARLY.clear()
     if not (info or multirun):
         _record_early(overrides)
+    chosen = chosen_plugins(overrides)
     try:
-        register_configs()
+        register_configs(chosen)
+        _log_dropped_experiment_settings(overrides, chosen)
         if not info and check_composition(overrides, multirun) and not multirun:
             multirun = True  # a config that sets hydra.mode: MULTIRUN (sweep=...)
             if "record" in _EARLY:

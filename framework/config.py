@@ -60,8 +60,33 @@ def plugin_config_class(family: str, name: str) -> type | None:
     return getattr(cls, "Config", None) if cls else None
 
 
-def register_configs() -> None:
-    """Fill Hydra's ConfigStore with the run schema, plugin configs and experiments."""
+#: dataclass-field metadata of a plugin setting that experiments do not set for it: an
+#: experiment's value (a generator's resolution, ``source.n_points``) is not applied when the
+#: plugin was chosen on the command line instead of the experiment's own (a user's file)
+NOT_FROM_EXPERIMENTS = "not_from_experiments"
+
+
+def experiment_settings_for(family: str, name: str, block: dict) -> tuple[dict, dict]:
+    """(kept, dropped): the part of an experiment's ``family`` settings that applies to the
+    plugin ``name`` chosen on the command line: the keys its Config has, less those marked
+    :data:`NOT_FROM_EXPERIMENTS`."""
+    config = plugin_config_class(family, name)
+    if config is None:
+        return dict(block), {}
+    valid = {f.name for f in dataclasses.fields(config)
+             if not f.metadata.get(NOT_FROM_EXPERIMENTS)}
+    kept = {k: v for k, v in block.items() if k in valid}
+    return kept, {k: v for k, v in block.items() if k not in valid}
+
+
+def register_configs(chosen: dict[str, str] | None = None) -> None:
+    """Fill Hydra's ConfigStore with the run schema, plugin configs and experiments.
+
+    ``chosen``: family -> plugin chosen on the command line (``source=file``). An experiment
+    that selects another plugin of that family keeps only the settings that apply to the chosen
+    one (:func:`experiment_settings_for`): ``experiment=sphere_willmore_random source=file``
+    does not pass the sphere's ``sampling`` to the file, nor its ``n_points`` to cut the file.
+    """
     from hydra.core.config_store import ConfigStore
     from omegaconf import OmegaConf
 
@@ -81,7 +106,14 @@ def register_configs() -> None:
             cs.store(group=family, name=name, node=config, provider=discover(group)[name].distribution)
     for folder in experiments_dirs():
         for path in sorted(folder.glob("*.yaml")):
-            cs.store(group="experiment", name=path.stem, node=OmegaConf.load(path), package="_global_")
+            node = OmegaConf.load(path)
+            for family, name in (chosen or {}).items():
+                block = node.get(family)
+                if block is not None and OmegaConf.is_dict(block):
+                    kept, _ = experiment_settings_for(
+                        family, name, OmegaConf.to_container(block, resolve=False))
+                    node[family] = kept
+            cs.store(group="experiment", name=path.stem, node=node, package="_global_")
 
 
 def experiment_usage(path: Path) -> str:

@@ -49,6 +49,8 @@ class RunContext:
     run_dir: Path = Path(".")
     log: logging.Logger = field(default_factory=lambda: logging.getLogger("pointatlas.run"))
     timings: dict[str, float] = field(default_factory=dict)
+    #: what the source said of the points it gave (PointCloud.info), for the results
+    source_info: dict = field(default_factory=dict)
 
     def rng(self, stream: str = "") -> np.random.Generator:
         """A generator seeded by the run seed and a stream name (independent streams)."""
@@ -69,7 +71,8 @@ class RunContext:
         """The selected plugin of ``family`` built from its config (plus ``overrides``)."""
         name = self.plugin_name(family)
         kwargs = {**plugin_kwargs(self.config.get(family)), **overrides}
-        return self.make(family, name, **kwargs)
+        plugin = self.make(family, name, **kwargs)
+        return _RecordedSource(plugin, self.source_info) if family == "source" else plugin
 
     def make(self, family: str, name: str, /, **kwargs: Any):
         """Build any installed plugin by name; config defaults fill missing keywords."""
@@ -92,6 +95,22 @@ class RunContext:
     def timed(self, label: str):
         """Context manager adding the wall time of a block to ``timings[label]`` (s)."""
         return _Timer(self.timings, label)
+
+
+class _RecordedSource:
+    """The run's source, whose ``load`` also records the cloud's ``info`` (how many points the
+    source holds and how many it used) for the results; everything else passes through."""
+
+    def __init__(self, source, store: dict):
+        self._source, self._store = source, store
+
+    def load(self, *args, **kwargs):
+        cloud = self._source.load(*args, **kwargs)
+        self._store.update(getattr(cloud, "info", {}) or {})
+        return cloud
+
+    def __getattr__(self, name: str):
+        return getattr(self._source, name)
 
 
 def _constructible(config: type) -> bool:

@@ -20,6 +20,8 @@ class PointCloud:
     exact : known exact quantities (``area``, ``euler_characteristic``, ``genus``...)
     parameters : (N, d) intrinsic coordinates of generated points, if known
     name : a short label for reports
+    info : how the points were obtained, for the results (``points_in_source``: how many the
+        source holds, ``points_used``: how many were kept)
     """
 
     points: np.ndarray
@@ -28,6 +30,7 @@ class PointCloud:
     exact: dict[str, float] = field(default_factory=dict)
     parameters: np.ndarray | None = None
     name: str = "points"
+    info: dict = field(default_factory=dict)
 
     def __post_init__(self):
         self.points = validate_points(self.points, what=f"{self.name} points")

@@ -48,6 +48,10 @@ def run_study(*, config: dict, choices: dict[str, str], overrides: list[str], ru
     overrides : the command-line overrides of this run (for the catalog and sweeps)
     run_id : the id under which the command line already recorded this run (a new one if None)
 
+    A study that sets ``ds.attrs["warnings"]`` (results it cannot fully vouch for, e.g. an
+    atlas with patches that failed the chart test, allowed by the user) is recorded as
+    ``completed_with_warnings`` with that text.
+
     Whatever fails after the run is recorded (the study, the results write, the metrics)
     marks the run ``failed`` in the catalog with its message and writes ``error.txt``; a
     catalog that cannot be used is reported once and does not stop the run.
@@ -79,6 +83,10 @@ def run_study(*, config: dict, choices: dict[str, str], overrides: list[str], ru
         ds = study.run(ctx)
         check_variables(ds)
         wall = time.perf_counter() - t0
+        for key, value in sorted(ctx.source_info.items()):
+            if isinstance(value, (int, float)) and f"source_{key}" not in ds:
+                ds[f"source_{key}"] = ((), value, {"long_name": f"source: {key.replace('_', ' ')}",
+                                                   "units": "1"})
         for label, seconds in sorted(ctx.timings.items()):
             ds[f"time_{label}"] = ((), seconds, {"long_name": f"wall time of {label}", "units": "s"})
         references = getattr(type(study), "references", {}) or {}
@@ -93,7 +101,7 @@ def run_study(*, config: dict, choices: dict[str, str], overrides: list[str], ru
             "seed": seed,
             "hostname": hostname(),
             "wall_time_s": wall,
-            "status": "completed",
+            "status": "completed_with_warnings" if ds.attrs.get("warnings") else "completed",
             "start_time": start,
             "end_time": now_iso(),
             "run_id": run_id,
@@ -111,7 +119,7 @@ def run_study(*, config: dict, choices: dict[str, str], overrides: list[str], ru
         record.failed(wall_time_s=time.perf_counter() - t0, error=message or type(exc).__name__)
         write_text_atomic(run_dir / ERROR_FILE, (message or type(exc).__name__) + "\n")
         raise
-    record.completed(wall_time_s=wall, metrics=metrics)
+    record.completed(wall_time_s=wall, metrics=metrics, warnings=str(ds.attrs.get("warnings") or ""))
     shown = ", ".join(f"{k}={v:.6g}" for k, v in metrics.items() if not k.startswith("time_"))
     log.info("run %s completed in %.2f s: %s", run_id, wall, shown)
     log.info("results: %s", path)

@@ -86,10 +86,15 @@ class RunRecorder:
             self._heartbeat.stop()
             self._heartbeat = None
 
-    def completed(self, *, wall_time_s: float, metrics: dict[str, float]) -> None:
+    def completed(self, *, wall_time_s: float, metrics: dict[str, float],
+                  warnings: str = "") -> None:
+        """Record the end of a run that wrote its results: ``completed``, or
+        ``completed_with_warnings`` when the study flagged results it cannot vouch for."""
         self.stop_heartbeat()
-        self._call("finish", self.run_id, status="completed", end_time=now_iso(),
-                   wall_time_s=wall_time_s, metrics=metrics)
+        self._call("finish", self.run_id,
+                   status="completed_with_warnings" if warnings else "completed",
+                   end_time=now_iso(), wall_time_s=wall_time_s, metrics=metrics,
+                   error=warnings or None)
 
     def failed(self, *, wall_time_s: float | None, error: str) -> None:
         self.stop_heartbeat()

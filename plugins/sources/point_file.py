@@ -1,13 +1,15 @@
 """Read a point set from a file: .npz, .ply, .vtk/.vtp/.vtu, .csv/.txt."""
 from __future__ import annotations
 
+import logging
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import ClassVar, Optional
 
 import numpy as np
 
+from pointatlas.config import NOT_FROM_EXPERIMENTS
 from pointatlas.errors import ConfigError, InputError
 from pointatlas.pointcloud import PointCloud, validate_points
 
@@ -155,9 +157,11 @@ class PointFile:
         path: str = "???"
         intrinsic_dim: Optional[int] = None
         name: Optional[str] = None
-        #: keep at most this many points; None keeps all. Lets an experiment's resolution
-        #: key (source.n_points) apply to files too.
-        n_points: Optional[int] = None
+        #: keep at most this many points; None keeps all. Set on the command line or in your
+        #: own experiment: an experiment made for a generator (sphere_willmore's
+        #: source.n_points: 5000) does not cut a file chosen with source=file.
+        n_points: Optional[int] = field(default=None,
+                                        metadata={NOT_FROM_EXPERIMENTS: True})
         #: how the n_points are chosen: 'farthest' (greedy farthest-point, quasi-uniform) or
         #: 'random' (a seeded random subset)
         subsample: str = "farthest"
@@ -232,7 +236,7 @@ class PointFile:
         if d is not None and not (isinstance(d, (int, np.integer)) and 1 <= d <= points.shape[1]):
             raise ConfigError(f"intrinsic_dim={d!r} is invalid: must be None or an integer in "
                               f"[1, {points.shape[1]}] (the ambient dimension of {path}).")
-        n = self.n_points
+        n, total = self.n_points, len(points)
         if n is not None:
             if n < len(points):
                 rng = rng if rng is not None else np.random.default_rng(0)
@@ -244,5 +248,10 @@ class PointFile:
                 else:
                     keep = rng.choice(len(points), size=n, replace=False)
                 points = points[np.sort(keep)]
+                logging.getLogger("pointatlas.sources").warning(
+                    "source %s: using %d of its %d points (%s subsample, source.n_points=%d); "
+                    "set source.n_points=null to use them all", path, n, total,
+                    self.subsample, n)
         return PointCloud(points=points, markers=markers, intrinsic_dim=d,
-                          name=self.name or path.stem)
+                          name=self.name or path.stem,
+                          info={"points_in_source": total, "points_used": len(points)})

@@ -88,3 +88,20 @@ def test_the_catalog_migrates_from_schema_1(tmp_path):
         """)
     (record,) = Catalog(path).runs()
     assert record.id == "old" and record.status == "running" and record.pid is None
+
+
+def test_results_with_warnings_are_recorded_as_such(tmp_path, monkeypatch):
+    from pointatlas_studies.embedding import EmbeddingStudy
+
+    original = EmbeddingStudy.run
+
+    def run_with_warning(self, ctx):
+        ds = original(self, ctx)
+        ds.attrs["warnings"] = "2 patches failed the chart test (allowed by the user)"
+        return ds
+
+    monkeypatch.setattr(EmbeddingStudy, "run", run_with_warning)
+    path = _run(tmp_path)
+    (record,) = Catalog(tmp_path / "outputs" / "catalog.sqlite").runs()
+    assert record.status == "completed_with_warnings" and "2 patches" in record.error
+    assert pointatlas.open_run(path).attrs["status"] == "completed_with_warnings"

@@ -27,7 +27,9 @@ increment, which is load controlled; an increment whose |Δλ| exceeds 1.5 nomin
 redone with a proportionally shorter arc); ``path.levels`` (tabulated load factors) are
 solved exactly, by load control from the last converged state, where the path first reaches
 them (the comparison with a table then needs no interpolation); a failed
-increment (no real root, NaN, too many iterations) halves Δs and retries.
+increment (no real root, NaN, too many iterations) halves Δs and retries. Every reported
+increment carries the state the loop goes on from (:mod:`.path_state`), so a resumed path
+(``start``) continues exactly.
 """
 from __future__ import annotations
 
@@ -39,6 +41,7 @@ import numpy as np
 from .branch_switching import confirmed_negative_count
 from .incremental import (Increment, PathFollowingError, PathSettings, load_increment,
                           make_increment)
+from .path_state import PathStart, PathState, check_start, penalty_of, restore_penalty
 
 
 def arc_mask(eq, n_dofs: int) -> np.ndarray:
@@ -117,47 +120,92 @@ def turned_back(U_new, U, dU_prev, m) -> bool:
 
 
 def follow_arc_length(eq, path: PathSettings, on_increment=None, log=None,
-                      start: Optional[Increment] = None) -> list[Increment]:
-    """Arc-length increments from λ = 0 (or ``start``) until λ ≥ ``path.max_load_factor``;
-    the last increment is brought back to exactly λ_max by a load-controlled solve."""
-    U = np.zeros(eq.F.size) if start is None else start.U.ravel().copy()
-    lam = 0.0 if start is None else start.load_factor
-    mu = np.zeros(eq.C.shape[0])
+                      start: Optional[PathStart] = None) -> list[Increment]:
+    """Arc-length increments from λ = 0 (or from ``start``, the increments of an interrupted
+    run and the state after them) until λ ≥ ``path.max_load_factor``; the last increment is
+    brought back to exactly λ_max by a load-controlled solve. Returns the new increments."""
     nominal = path.max_load_factor / path.n_increments
-    mask = arc_mask(eq, U.size)
-    done: list[Increment] = []
-    # negative pivots before the first increment: none in the unloaded state, the stored
-    # count of a resumed one (-1 if unknown: no branch switch until it is known)
-    start_negative = 0 if start is None else start.negative_pivots
-    # the first increment is load controlled; its length |ΔU| is the arc length Δs₀ (the
-    # linear predictor overestimates the response of a stiffening shell by orders of
-    # magnitude, and a sphere of that radius may never meet the path)
-    pending = {float(x) for x in path.levels if x > lam}
-    step = min([nominal, *pending])
+    state = check_start(start, "arc_length")
+    done: list[Increment] = [] if start is None else list(start.increments)
+    n_before = len(done)
+    # negative pivots before the first increment: none in the unloaded state
+    start_negative = 0
+
+    def report(inc: Increment, tail) -> None:
+        """Record ``inc`` with the loop state the path goes on from (``tail``: the branch
+        switch test and Δs adaptation still due, or None)."""
+        inc.state = PathState("arc_length", lam, U.copy(), mu.copy(), ds, previous=dU_prev.copy(),
+                              first_step=ds0, pending=tuple(sorted(pending)), switches=switches,
+                              check_switch=bool(tail and tail[0]),
+                              adapt_iterations=-1 if tail is None else int(tail[1]),
+                              rho=penalty_of(eq))
+        done.append(inc)
+        if on_increment is not None:
+            on_increment(inc)
+
+    if state is None:
+        U, lam, mu = np.zeros(eq.F.size), 0.0, np.zeros(eq.C.shape[0])
+        mask = arc_mask(eq, U.size)
+        # the first increment is load controlled; its length |ΔU| is the arc length Δs₀ (the
+        # linear predictor overestimates the response of a stiffening shell by orders of
+        # magnitude, and a sphere of that radius may never meet the path)
+        pending = {float(x) for x in path.levels if x > lam}
+        step = min([nominal, *pending])
+        while True:
+            t0 = time.perf_counter()
+            first = load_increment(eq, path, U, mu, lam + step, log)
+            if first is not None:
+                break
+            step *= 0.5
+            if step < path.min_step * nominal:
+                raise PathFollowingError(
+                    f"arc length: the first increment from λ = {lam:.5g} did not converge even "
+                    f"at {step / nominal:.3g} of the nominal step. Use more increments.")
+        U_new, mu_new, it, residuals, negative = first
+        dU_prev = mask * (U_new - U)
+        ds0 = float(np.linalg.norm(dU_prev))
+        if not (np.isfinite(ds0) and ds0 > 0):
+            raise PathFollowingError("arc length: the load (F, g) produces no displacement; "
+                                     "give a load or an imposed displacement.")
+        U, mu, lam = U_new, mu_new, lam + step
+        pending = {x for x in pending if x > lam * (1 + 1e-12)}
+        ds, switches, tail = ds0, 0, None
+        report(make_increment(eq, U, mu, lam, it, residuals, negative, t0), tail)
+    else:
+        U, lam, mu = state.U.copy(), state.load_factor, state.mu.copy()
+        mask = arc_mask(eq, U.size)
+        dU_prev, ds, ds0 = state.previous.copy(), state.step, state.first_step
+        pending, switches = set(state.pending), state.switches
+        tail = None if state.adapt_iterations < 0 else (state.check_switch,
+                                                        state.adapt_iterations)
+        restore_penalty(eq, state)
+    # resumed after a tabulated level (a side solve in the middle of an arc step): the arc
+    # step is redone from the state before it, without counting the level against
+    # max_increments again, and the next level's solve starts from the ρ it had then
+    mid_step = state is not None and start.increments[-1].load_factor != state.load_factor
     while True:
-        t0 = time.perf_counter()
-        first = load_increment(eq, path, U, mu, lam + step, log)
-        if first is not None:
+        if tail is not None:
+            # after the last increment: the branch switch test, then Δs adapts to the
+            # Newton iterations
+            check, it = tail
+            tail = None
+            if check:
+                t0 = time.perf_counter()
+                switched = switch_branch(eq, path, U, mu, lam, ds, dU_prev, mask, log)
+                if switched is not None:
+                    switches += 1
+                    U_new, mu_new, lam_new, it, residuals, negative = switched
+                    dU_prev = mask * (U_new - U)
+                    U, mu, lam = U_new, mu_new, lam_new
+                    pending.difference_update(x for x in list(pending) if x <= lam)
+                    tail = (False, it)
+                    report(make_increment(eq, U, mu, lam, it, residuals, negative, t0), tail)
+                    continue
+            ds = min(ds * float(np.clip(np.sqrt(path.desired_iterations / max(it, 1)), 0.5,
+                                        2.0)), ds0)
+        if not lam < path.max_load_factor * (1 - 1e-12):
             break
-        step *= 0.5
-        if step < path.min_step * nominal:
-            raise PathFollowingError(
-                f"arc length: the first increment from λ = {lam:.5g} did not converge even "
-                f"at {step / nominal:.3g} of the nominal step. Use more increments.")
-    U_new, mu_new, it, residuals, negative = first
-    dU_prev = mask * (U_new - U)
-    ds0 = float(np.linalg.norm(dU_prev))
-    if not (np.isfinite(ds0) and ds0 > 0):
-        raise PathFollowingError("arc length: the load (F, g) produces no displacement; give a "
-                                 "load or an imposed displacement.")
-    U, mu, lam = U_new, mu_new, lam + step
-    pending = {x for x in pending if x > lam * (1 + 1e-12)}
-    done.append(make_increment(eq, U, mu, lam, it, residuals, negative, t0))
-    if on_increment is not None:
-        on_increment(done[-1])
-    ds, switches = ds0, 0
-    while lam < path.max_load_factor * (1 - 1e-12):
-        if len(done) >= path.max_increments:
+        if len(done) >= path.max_increments and not mid_step:
             raise PathFollowingError(
                 f"arc length: λ = {lam:.5g} after {len(done)} increments without reaching "
                 f"λ_max = {path.max_load_factor:g}. The converged increments are saved. "
@@ -198,41 +246,28 @@ def follow_arc_length(eq, path: PathSettings, on_increment=None, log=None,
             if exact is not None:
                 U_new, mu_new, it, residuals, negative = exact
                 lam_new = path.max_load_factor
+        if mid_step:
+            restore_penalty(eq, state)
+            mid_step = False
         if lam_new > lam:
             # tabulated levels first reached in (λ, λ_new]: land on them by load control
+            # (side solves from the current state, which a resumed run redoes the arc from)
             for level in sorted(x for x in pending if lam < x < lam_new):
                 t1 = time.perf_counter()
                 exact = load_increment(eq, path, U, mu, level, log)
                 pending.discard(level)
                 if exact is not None:
-                    done.append(make_increment(eq, exact[0], exact[1], level, *exact[2:], t1))
-                    if on_increment is not None:
-                        on_increment(done[-1])
+                    report(make_increment(eq, exact[0], exact[1], level, *exact[2:], t1), None)
             pending.difference_update(x for x in list(pending) if x <= lam_new)
-        dU_prev = mask * (U_new - U)
         rising = lam_new > lam and (len(done) < 2 or
                                     done[-1].load_factor > done[-2].load_factor)
+        before = done[-1].negative_pivots if done else start_negative
+        dU_prev = mask * (U_new - U)
         U, mu, lam = U_new, mu_new, lam_new
-        done.append(make_increment(eq, U, mu, lam, it, residuals, negative, t0))
-        if on_increment is not None:
-            on_increment(done[-1])
-        before = done[-2].negative_pivots if len(done) >= 2 else start_negative
-        if (path.branch_switching and switches < path.max_branch_switches and rising
-                and negative > before >= 0):
-            t0 = time.perf_counter()
-            switched = switch_branch(eq, path, U, mu, lam, ds, dU_prev, mask, log)
-            if switched is not None:
-                switches += 1
-                U_new, mu_new, lam_new, it, residuals, negative = switched
-                dU_prev = mask * (U_new - U)
-                U, mu, lam = U_new, mu_new, lam_new
-                pending.difference_update(x for x in list(pending) if x <= lam)
-                done.append(make_increment(eq, U, mu, lam, it, residuals, negative, t0))
-                if on_increment is not None:
-                    on_increment(done[-1])
-        ds = min(ds * float(np.clip(np.sqrt(path.desired_iterations / max(it, 1)), 0.5, 2.0)),
-                 ds0)
-    return done
+        tail = (path.branch_switching and switches < path.max_branch_switches and rising
+                and negative > before >= 0, it)
+        report(make_increment(eq, U, mu, lam, it, residuals, negative, t0), tail)
+    return done[n_before:]
 
 
 def switch_branch(eq, path: PathSettings, U, mu, lam: float, ds: float, step, mask, log=None):

@@ -44,6 +44,10 @@ def negative_modes(system, count: int, tol: float = 1e-8, max_iter: int = 100,
     A = system.matrix
     n = A.shape[0]
     inverse = LinearOperator(A.shape, matvec=system.inverse, dtype=float)
+    # a fixed starting vector: ARPACK's own random one depends on the calls made before in
+    # the process, so a resumed path would pick other eigenvector signs than an
+    # uninterrupted one
+    v0 = np.random.default_rng(0).uniform(0.5, 1.5, n)
     vals, vecs, nearest = np.zeros(0), np.zeros((n, 0)), np.zeros(0)
     for which, k in (("LM", max(count, 1) + 6), ("SA", max(count, 1))):
         k = int(min(k, n - 2))
@@ -51,7 +55,7 @@ def negative_modes(system, count: int, tol: float = 1e-8, max_iter: int = 100,
             break
         try:
             vals, vecs = eigsh(A, k=k, sigma=0.0, which=which, OPinv=inverse, tol=tol,
-                               maxiter=max_iter)
+                               maxiter=max_iter, v0=v0)
         except ArpackNoConvergence as exc:
             vals, vecs = exc.eigenvalues, exc.eigenvectors
         if which == "LM":

@@ -33,6 +33,10 @@ kept and a message naming the remedies. The signs of the pivots of the factorise
 K_T + ρCᵀC flag unstable equilibria (negative pivots: not a minimum); a negative count is
 confirmed by Lanczos on the same factorisation (:func:`.branch_switching.
 confirmed_negative_count`), since round-off can flip the sign of a tiny pivot.
+
+Every reported increment carries the follower's state after it (:mod:`.path_state`), and
+``start`` (a :class:`.path_state.PathStart`) continues a path from such a state exactly: a
+resumed run reports the same increments as an uninterrupted one.
 """
 from __future__ import annotations
 
@@ -44,6 +48,7 @@ import numpy as np
 
 from pointatlas.errors import PointatlasError
 
+from .path_state import PathStart, PathState, check_start, penalty_of, restore_penalty
 from .stable_equilibrium import armijo_step, minimise_to_stable, snap_amplitude
 
 
@@ -75,6 +80,7 @@ class Increment:
     seconds: float
     reactions: Optional[np.ndarray] = None   # (n_supports, 3) resultant reaction forces
     snapped: bool = False         # reached by a snap to a stable state (stable_path)
+    state: Optional[PathState] = None   # the path follower's state after it (resume)
 
 
 @dataclass
@@ -98,9 +104,10 @@ class PathSettings:
 
 def follow_path(model, settings, path: PathSettings, F: np.ndarray, constraints,
                 on_increment: Optional[Callable[[Increment], None]] = None, log=None,
-                start: Optional[Increment] = None) -> list[Increment]:
-    """Increments from λ = 0 (or ``start``) to ``path.max_load_factor``: load control
-    (uniform steps, cut on failure) or arc length (``path.control``)."""
+                start: Optional[PathStart] = None) -> list[Increment]:
+    """Increments from λ = 0 (or from ``start``, the increments of an interrupted run and the
+    state after them) to ``path.max_load_factor``: load control (uniform steps, cut on
+    failure) or arc length (``path.control``). Returns the new increments."""
     from .equilibrium import Equilibrium
 
     eq = Equilibrium(model, settings, F, constraints)
@@ -110,12 +117,15 @@ def follow_path(model, settings, path: PathSettings, F: np.ndarray, constraints,
         return follow_arc_length(eq, path, on_increment, log, start)
     if path.control != "load":
         raise ValueError(f"unknown control {path.control!r}: use 'load' or 'arc_length'")
-    U = np.zeros(eq.F.size) if start is None else start.U.ravel().copy()
-    lam_load = 0.0 if start is None else start.load_factor
-    mu = np.zeros(eq.C.shape[0])
     nominal = path.max_load_factor / path.n_increments
-    step = nominal
-    prev = None        # (U, step) of the previous increment, for the secant predictor
+    state = check_start(start, "load")
+    if state is None:
+        U, lam_load, mu, step = np.zeros(eq.F.size), 0.0, np.zeros(eq.C.shape[0]), nominal
+        prev = None    # (U, step) of the previous increment, for the secant predictor
+    else:
+        U, lam_load, mu, step = state.U.copy(), state.load_factor, state.mu.copy(), state.step
+        prev = None if state.previous is None else (state.previous.copy(), state.previous_step)
+        restore_penalty(eq, state)
     done: list[Increment] = []
     levels = sorted(float(x) for x in path.levels if x > lam_load)
     while lam_load < path.max_load_factor * (1 - 1e-12):
@@ -155,12 +165,16 @@ def follow_path(model, settings, path: PathSettings, F: np.ndarray, constraints,
         prev = None if snapped else (U, target - lam_load)
         U, mu, it, residuals, negative = result
         lam_load = target
-        done.append(make_increment(eq, U, mu, lam_load, it, residuals, negative, t0))
-        done[-1].snapped = snapped
-        if on_increment is not None:
-            on_increment(done[-1])
         if it <= 4:  # converging easily: grow the step back towards its nominal size
             step = min(2 * step, nominal)
+        done.append(make_increment(eq, U, mu, lam_load, it, residuals, negative, t0))
+        done[-1].snapped = snapped
+        done[-1].state = PathState(
+            "load", lam_load, U.copy(), mu.copy(), step,
+            previous=None if prev is None else prev[0].copy(),
+            previous_step=np.nan if prev is None else prev[1], rho=penalty_of(eq))
+        if on_increment is not None:
+            on_increment(done[-1])
     return done
 
 

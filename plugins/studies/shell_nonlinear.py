@@ -19,14 +19,16 @@ and records, along a dim ``increment``: ``load_factor``, ``load`` (= load_factor
 under loads),
 the monitored displacements (``monitor_variable`` with dims (increment, point), point named
 by ``monitor_names``), the energy split, Newton iterations and the displacement field. After
-every converged increment ``increments.nc`` in the run directory is rewritten (atomically), so
-an interrupted run keeps its converged increments; ``resume_from`` (a run directory) restarts
-from the last increment stored there. Published curves (``reference_load_factors`` ×
-``reference_values``, one row per monitored point) give ``max_relative_error``.
+every converged increment ``increments.nc`` in the run directory is rewritten durably, with
+the path follower's state (:mod:`.increment_store`), so an interrupted run keeps every
+converged increment; ``resume_from`` (the run directory of an interrupted run with the same
+settings) continues the path exactly where it stopped, and its results hold every increment,
+the earlier ones included, as an uninterrupted run's would. Published curves
+(``reference_load_factors`` × ``reference_values``, one row per monitored point) give
+``max_relative_error``.
 """
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import ClassVar, List, Optional
@@ -82,6 +84,27 @@ class ShellNonlinearStudy:
 
         return AtlasSettings.of(self)
 
+    def check_config(self) -> None:
+        """Start-up checks that need no model (run before the run directory is made): the
+        atlas settings, the path's numbers, and ``resume_from`` naming a run directory that
+        holds increments.nc (its contents are checked when the run reads it)."""
+        import math
+
+        from pointatlas.errors import ConfigError
+
+        self.atlas_settings().check()
+        for name, positive in (("max_load_factor", True), ("newton_tol", True),
+                               ("lbfgs_tol", True), ("full_load", False),
+                               ("magnification", False)):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and (v > 0 or not positive)):
+                raise ConfigError(f"study.{name} = {v!r} is invalid; it must be a finite number"
+                                  f"{' > 0' if positive else ''}.")
+        if self.resume_from:
+            from .increment_store import check_resume_dir
+
+            check_resume_dir(self.resume_from)
+
     def _monitors(self):
         from pointatlas.errors import ConfigError
 
@@ -105,9 +128,15 @@ class ShellNonlinearStudy:
 
         from pointatlas.errors import ConfigError
 
+        from .increment_store import read_increments, remove_leftovers, run_settings
+
         if ctx.plugin_name("physics") != "kirchhoff_love":
             raise ConfigError("study=shell_nonlinear needs physics=kirchhoff_love.")
         P, E, names = self._monitors()
+        remove_leftovers(ctx.run_dir)
+        settings = run_settings(ctx)
+        # checked before the model is built: a wrong resume_from fails in a moment
+        history = read_increments(self.resume_from, settings) if self.resume_from else []
         atlas_settings = self.atlas_settings()
         atlas_settings.check()
         with ctx.timed("source"):
@@ -119,8 +148,8 @@ class ShellNonlinearStudy:
                                 log=ctx.log)
             F = assemble_loads(model, s, ctx.log)
             cons = assemble_supports(model, s)
-        start = self._resume(model) if self.resume_from else None
-        records = [] if start is None else [start]
+        start = self._resume(history, model, cons) if history else None
+        records = list(history)
         probe = monitor_operator(model, P, E)   # projections once, not per increment
         fields = point_fields(model)             # u and energy density at the sampled points
         values = [probe(r.U) for r in records]
@@ -147,7 +176,7 @@ class ShellNonlinearStudy:
             ctx.log.info("increment %d: λ = %.5g, %d Newton iterations, %s; %s", len(records),
                          inc.load_factor, inc.iterations, "stable" if inc.stable else "UNSTABLE",
                          ", ".join(f"{n} = {v:.5g}" for n, v in zip(names, values[-1])))
-            self._write(ctx.run_dir / "increments.nc", model, records, values, names)
+            self._write(ctx.run_dir / "increments.nc", model, records, values, names, settings)
 
         from pointatlas_physics.kirchhoff_love.incremental import PathFollowingError
 
@@ -202,22 +231,22 @@ class ShellNonlinearStudy:
         return total, ("reaction force of the imposed-displacement supports along their "
                        "imposed direction")
 
-    def _resume(self, model):
-        import xarray as xr
-        from pointatlas_physics.kirchhoff_love.incremental import Increment
+    def _resume(self, history, model, cons):
+        """Where the path goes on from the increments of ``resume_from``, after checking that
+        they fit this model (same settings give the same model; this guards the file)."""
+        from pointatlas_physics.kirchhoff_love.path_state import PathStart
 
-        path = Path(self.resume_from) / "increments.nc"
-        with xr.open_dataset(path) as old:
-            U = old["nodal_displacement"].isel(increment=-1).values
-            lam = float(old["load_factor"].isel(increment=-1))
-            negative = (int(old["negative_pivots"].isel(increment=-1))
-                        if "negative_pivots" in old else -1)
-        if U.shape != model.nodes.shape:
-            from pointatlas.errors import InputError
+        from pointatlas.errors import InputError
 
-            raise InputError(f"{path} holds {U.shape[0]} nodes but this model has "
-                             f"{model.nodes.shape[0]}: resume with the same source and settings.")
-        return Increment(lam, U, 0, [], {}, negative, negative == 0, 0.0)
+        state = history[-1].state
+        if (history[-1].U.shape != model.nodes.shape or state.U.size != model.nodes.size
+                or state.mu.size != cons.matrix.shape[0]):
+            raise InputError(f"study.resume_from={self.resume_from}: its increments hold "
+                             f"{history[-1].U.shape[0]} nodes and {state.mu.size} support rows "
+                             f"but this model has {model.nodes.shape[0]} and "
+                             f"{cons.matrix.shape[0]}: resume with the same source and "
+                             "settings, or rerun without study.resume_from.")
+        return PathStart(history, state)
 
     def _dataset(self, model, records, values, names):
         from .shell_path_results import path_dataset
@@ -226,16 +255,11 @@ class ShellNonlinearStudy:
         return path_dataset(self, model.dof, self._points, records, values, names,
                             self._fields, pairs)
 
-    def _write(self, path: Path, model, records, values, names):
-        """increments.nc with all converged increments (temporary file, then rename)."""
-        ds = self._dataset(model, records, values, names)
-        ds["nodal_displacement"] = (("increment", "node", "dim"),
-                                    np.stack([r.U for r in records]),
-                                    {"long_name": "nodal displacements U (ghosts included)",
-                                     "units": "length"})
-        tmp = path.with_name(path.stem + ".partial.nc")
-        ds.to_netcdf(tmp)
-        os.replace(tmp, path)
+    def _write(self, path: Path, model, records, values, names, settings):
+        """increments.nc with all converged increments and the path state (durably)."""
+        from .increment_store import write_increments
+
+        write_increments(path, self._dataset(model, records, values, names), records, settings)
 
     @staticmethod
     def report_figures(ds):

@@ -23,12 +23,20 @@ def test_open_hemisphere_path_and_resume(tmp_path, run_cli):
     assert int(ds["stable"].min()) == 1
     with xr.open_dataset(run_dir / "increments.nc") as inc:
         assert inc.sizes["increment"] == 2 and "nodal_displacement" in inc
-    r = run_cli("pointatlas", *ARGS[:-2], "study.max_load_factor=0.15", "study.n_increments=3",
-                f"study.resume_from={run_dir}", f"outputs_root={tmp_path / 'out2'}",
-                "quiet=true", cwd=tmp_path)
+    # resuming the finished path gives its results again, every increment included
+    r = run_cli("pointatlas", *ARGS, f"study.resume_from={run_dir}",
+                f"outputs_root={tmp_path / 'out2'}", cwd=tmp_path)
     assert r.returncode == 0, r.stderr[-2000:]
     resumed = open_run(next((tmp_path / "out2").glob("runs/*/*")))
-    assert resumed["load_factor"].values.tolist() == pytest.approx([0.1, 0.15])
+    assert resumed["load_factor"].values.tolist() == pytest.approx([0.05, 0.1])
+    assert resumed["radial_displacement"].values == pytest.approx(
+        ds["radial_displacement"].values, abs=1e-12)
+    # a resume with another path is refused, naming the setting (one line, no traceback)
+    r = run_cli("pointatlas", *ARGS[:-2], "study.max_load_factor=0.15", "study.n_increments=3",
+                f"study.resume_from={run_dir}", f"outputs_root={tmp_path / 'out3'}",
+                "quiet=true", cwd=tmp_path)
+    assert r.returncode != 0 and "Traceback" not in r.stderr
+    assert "study.max_load_factor = 0.1" in r.stderr and "study.max_load_factor = 0.15" in r.stderr
 
 
 def test_nonlinear_run_on_a_vtp_point_cloud_needs_no_code(tmp_path, run_cli):

@@ -7,8 +7,9 @@ Each trial starts a real ``pointatlas`` command and ends it with ``kill -9``:
 - ``increments_write``: the moment a temporary ``.increments.nc.*.tmp`` appears (a nonlinear
   shell path, during the write of its increments file).
 
-Two kinds of run: ``surface`` (the default sphere_willmore study, 3 000 points) and ``shell``
-(the open hemisphere along its nonlinear load path, 200 points, 4 increments). While a shell
+Two kinds of run: ``surface`` (the default sphere_willmore study, 1 500 points) and ``shell``
+(the open hemisphere along its nonlinear load path, 200 points, to 0.3 of the load in
+increments of 0.25 of it, cut where Newton needs it). While a shell
 run works, the script reads the published ``increments.nc`` every few milliseconds and keeps
 the largest number of increments it saw: those had converged and been written before the
 kill. After each kill it counts
@@ -44,8 +45,9 @@ import numpy as np
 
 BIN = Path(sys.executable).parent
 RUNS = {
-    "surface": ["source.n_points=3000"],
-    "shell": ["experiment=shell_open_hemisphere", "source.n_points=200", "study.n_increments=4"],
+    "surface": ["source.n_points=1500"],
+    "shell": ["experiment=shell_open_hemisphere", "source.n_points=200", "study.n_increments=4",
+              "study.max_load_factor=0.3"],
 }
 MODES = ("random", "results_write", "increments_write")
 
@@ -178,8 +180,10 @@ def main() -> None:
     work = Path(tempfile.mkdtemp(prefix="kill_runs_"))
     root = work / "outputs"
     duration = {kind: typical_seconds(kind, root) for kind in RUNS}
-    print(f"typical durations: " + ", ".join(f"{k} {v:.1f} s" for k, v in duration.items()))
+    print("typical durations: " + ", ".join(f"{k} {v:.1f} s" for k, v in duration.items()),
+          flush=True)
     plan = [("surface", "random"), ("surface", "results_write"), ("shell", "random"),
+            ("surface", "random"), ("shell", "increments_write"), ("surface", "results_write"),
             ("shell", "results_write"), ("shell", "increments_write")]
     trials = []
     for i in range(args.kills):
@@ -187,7 +191,8 @@ def main() -> None:
         trials.append(trial(kind, mode, root, work / f"run{i:03d}", duration[kind], rng))
         t = trials[-1]
         print(f"{i:3d} {kind:7s} {mode:16s} t={t['killed_at_s']:6.2f} s in_write={t['in_write']!s:5s} "
-              f"increments {t['seen']}->{t['after']} corrupt={t['corrupt']} row={t['status']}")
+              f"finished={t['finished']!s:5s} increments {t['seen']}->{t['after']} "
+              f"corrupt={t['corrupt']} row={t['status']}", flush=True)
     gc = subprocess.run([str(BIN / "pointatlas-runs"), "gc", "--root", str(root)],
                         capture_output=True, text=True)
     leftovers = sum(1 for p in work.rglob(".*.tmp")) + sum(1 for p in work.rglob("*.partial.nc"))

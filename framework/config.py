@@ -36,6 +36,8 @@ class RunConfig:
     approximant: Any = None
     physics: Any = None
     study: Any = None
+    #: the atlas settings (``atlas.gamma_lme=...``; the ``atlas`` plugin family)
+    atlas: Any = None
     #: seeds every random choice of the run (numpy, random, scikit-learn, generators)
     seed: int = 0
     #: only warnings and errors in the log (no progress lines)

@@ -22,6 +22,7 @@ FAMILIES: dict[str, str] = {
     "pointatlas.approximants": "approximant",
     "pointatlas.physics": "physics",
     "pointatlas.studies": "study",
+    "pointatlas.atlases": "atlas",
 }
 _ALIASES = {short: group for group, short in FAMILIES.items()}
 _ALIASES.update({group.split(".", 1)[1]: group for group in FAMILIES})

@@ -163,12 +163,19 @@ def check_study(cls: type, **kwargs: Any) -> None:
     assert callable(getattr(cls, "run", None)), f"{cls.__name__} must define run(ctx)"
 
 
+def check_atlas(cls: type, **kwargs: Any) -> None:
+    check_contract(cls)
+    assert callable(getattr(cls, "settings", None)), (
+        f"{cls.__name__} must define settings() returning the atlas settings")
+
+
 CHECKS = {
     "source": check_source,
     "embedder": check_embedder,
     "approximant": check_approximant,
     "physics": check_physics,
     "study": check_study,
+    "atlas": check_atlas,
 }
 
 

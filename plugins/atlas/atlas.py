@@ -15,14 +15,16 @@ import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.spatial import cKDTree
 
-from pointatlas.errors import InputError
+from pointatlas.errors import InputError, PointatlasError
 
 from . import differential_geometry as dg
 from . import memory_estimate as mem
-from .settings import AtlasSettings
+from .settings import GEOMETRY_MARKERS_PER_PATCH, AtlasSettings
 from .chart import Chart, ChartQuadrature, build_chart, chart_quadrature
 from .quadrature import simplex_rule
 from .partition import embedding_defects, is_connected, partition_markers, refine_partition
+from .chart_repair import (AtlasError, EmbeddingAttempt, chart_passes, failed_patches_message,
+                           repair_embedders, serial_threads)
 
 
 @dataclass
@@ -95,25 +97,51 @@ class Atlas:
         return self._margin_csr
 
     def _embedding(self, J: np.ndarray) -> np.ndarray:
-        """Ξ_κ = R_κ(P_J), computed once per control set (acceptance test and chart)."""
+        """Ξ_κ = R_κ(P_J) by the embedder the chart test accepted (the least bad one if none
+        did), computed once per control set: the acceptance test's embedding is the chart's."""
+        return self._embedding_attempt(J).xi
+
+    def _embedding_attempt(self, J: np.ndarray) -> EmbeddingAttempt:
+        """Embed P_J with the configured embedder and, while the chart test fails, with the
+        geodesic ones (:func:`chart_repair.repair_embedders`); cached per control set."""
         key = J.tobytes()
-        if key not in self._embeddings:
-            self._embeddings[key] = np.asarray(self.make_embedder().fit_transform(self.points_[J]),
-                                               dtype=np.float64)
-        return self._embeddings[key]
+        if key in self._embeddings:
+            return self._embeddings[key]
+        s, P = self.settings, self.points_[J]
+        best = None
+        for i, (name, make) in enumerate(self._repair_chain):
+            try:
+                if i == 0:                      # the configured embedder: errors are the user's
+                    xi = make(J.size).fit_transform(P)
+                else:                           # small dense problems: one thread
+                    with serial_threads():
+                        xi = make(J.size).fit_transform(P)
+            except PointatlasError:
+                if i == 0:
+                    raise
+                continue                        # e.g. a disconnected k-NN graph: next one
+            xi = np.asarray(xi, dtype=np.float64)
+            if J.size < 10:                     # too few points to test: kept as embedded
+                best = EmbeddingAttempt(name, xi, {}, True)
+                break
+            defects = embedding_defects(P, xi)
+            attempt = EmbeddingAttempt(name, xi, defects,
+                                       chart_passes(defects, s.max_stress, s.max_distortion))
+            if best is None or attempt.passed or (attempt.badness(s.max_stress, s.max_distortion)
+                                                  < best.badness(s.max_stress, s.max_distortion)):
+                best = attempt
+            if attempt.passed:
+                break
+        self._embeddings[key] = best
+        return best
 
     def _acceptable(self, members: np.ndarray) -> bool:
-        s = self.settings
         if not is_connected(self.adjacency_, members):
             return False
         J, _ = self._control_set(members)
-        if J.size < 10:
-            return True
-        xi = self._embedding(J)
-        defects = embedding_defects(self.points_[J], xi)
-        self.defects_[tuple(members[:3])] = defects
-        return (defects["flip_fraction"] == 0.0 and defects["stress"] < s.max_stress
-                and defects["distortion"] < s.max_distortion)
+        attempt = self._embedding_attempt(J)
+        self.defects_[tuple(members[:3])] = attempt.defects
+        return attempt.passed
 
     def estimated_bytes(self, n_points: int, n_markers: int, ambient_dim: int, chart_dim: int,
                         keep_basis: bool = False) -> int:
@@ -149,13 +177,40 @@ class Atlas:
         self.h_points_ = float(np.median(self.point_tree_.query(P, k=2)[0][:, 1]))
         self.pu_ = self.make_pu().fit(Q)
         self.W_points_ = self.pu_.evaluate(P, order=0).to_csr(Q.shape[0]).tocsc()
-        n_parts = s.n_patches or max(1, int(round(Q.shape[0] / s.markers_per_patch)))
+        per_patch = s.markers_per_patch or GEOMETRY_MARKERS_PER_PATCH
+        n_parts = s.n_patches or max(1, int(round(Q.shape[0] / per_patch)))
         labels, self.adjacency_ = partition_markers(Q, n_parts, s.graph_neighbors)
         self.initial_n_patches_ = int(labels.max()) + 1
         self.defects_ = {}
-        self.labels_, self.accepted_ = refine_partition(
+        self._repair_chain = repair_embedders(self.make_embedder, self.chart_dim_)
+        self.repair_embedders_ = [name for name, _ in self._repair_chain]
+        self.labels_, self.accepted_, self.patch_depth_ = refine_partition(
             labels, self.adjacency_, self._acceptable, max_depth=s.max_refinement_depth)
+        attempts = [self._patch_attempt(k) for k in range(self.accepted_.size)]
+        self.patch_embedder_ = np.array(["none" if a is None else a.embedder for a in attempts])
+        if not self.accepted_.all() and not s.allow_failed_patches:
+            raise AtlasError(self._failed_patches_message(refuse=True))
         return self.labels_
+
+    def _patch_attempt(self, k: int) -> Optional[EmbeddingAttempt]:
+        """The embedding kept for final patch k (None: a disconnected patch, never embedded)."""
+        J, _ = self._control_set(np.flatnonzero(self.labels_ == k))
+        return self._embeddings.get(J.tobytes())
+
+    def failed_point_fraction(self) -> float:
+        """Σ_a Σ_{κ failed} ψ_κ(P_a) / N: the share of the points, by the partition of unity,
+        on patches that fail the chart test (after :meth:`partition`)."""
+        failed = ~self.accepted_[self.labels_]          # per marker
+        psi = self.W_points_ @ failed.astype(np.float64)
+        return float(np.mean(psi))
+
+    def _failed_patches_message(self, refuse: bool) -> str:
+        s = self.settings
+        return failed_patches_message(
+            self.markers_, self.labels_, self.accepted_,
+            [self._patch_attempt(k) for k in range(self.accepted_.size)], s.max_stress,
+            s.max_distortion, self.repair_embedders_, self.failed_point_fraction(),
+            s.max_refinement_depth, refuse=refuse)
 
     def _check_memory(self, n_points: int, n_markers: int, ambient_dim: int,
                       keep_basis: bool) -> None:
@@ -172,18 +227,11 @@ class Atlas:
             "lower study.quadrature_order, or a machine with more memory.")
 
     def refinement_warning(self) -> Optional[str]:
-        """Why the atlas may be wrong, if patches still fail the chart test after
-        :meth:`partition` (the refinement limit accepts them anyway); else None."""
-        n_bad = int((~self.accepted_).sum())
-        if n_bad == 0:
+        """Why the atlas may be wrong, if patches still fail the chart test after the repair
+        of :meth:`partition` (only with ``allow_failed_patches``: else it refused); else None."""
+        if self.accepted_.all():
             return None
-        s = self.settings
-        return (f"{n_bad} of {self.accepted_.size} patch(es) still fail the chart test (fold, "
-                f"stress > {s.max_stress:g} or distortion > {s.max_distortion:g}) at the "
-                "refinement limit, so their charts may be folded and integrals, strains and "
-                "energies wrong there. Sample the surface more densely, lower markers_per_patch, "
-                "chart_margin, raise gamma_pu (a narrower partition of unity), or try another embedder (isomap for curved "
-                "strips such as thin pipes).")
+        return self._failed_patches_message(refuse=False)
 
     def build_charts(self, progress=lambda it, **kw: it) -> list[Chart]:
         """One chart per patch (after :meth:`partition`). With least_squares_fit, the control
@@ -196,8 +244,8 @@ class Atlas:
         for k in progress(range(L), total=L, desc="charts"):
             members = np.flatnonzero(self.labels_ == k)
             J, psi = self._control_set(members)
-            xi = self._embeddings.get(J.tobytes())
-            self.charts_.append(build_chart(self.points_, J, self.make_embedder(), self.make_lme,
+            xi = self._embedding(J)  # the embedding the chart test accepted (chart_repair)
+            self.charts_.append(build_chart(self.points_, J, None, self.make_lme,
                                             s.least_squares_fit and per_chart, xi=xi))
             self.support_.append(psi)
         if s.least_squares_fit and not per_chart:
@@ -220,6 +268,9 @@ class Atlas:
                 self.charts_[k], self.support_[k], lambda X, m=members: self._patch_values(X, m),
                 s.quadrature_order, s.tol_pu, need_second,
                 real=None if real is None else np.asarray(real, bool)[J], keep_basis=keep_basis))
+        from .orientation import orient_atlas
+
+        orient_atlas(self)  # chart_orientation_, orientation_, orientable_: one side for all
         return self.quadrature_
 
     def build(self, points, markers=None, progress=lambda it, **kw: it,
@@ -234,11 +285,16 @@ class Atlas:
         q = self.quadrature_
         T = np.concatenate([c.tangents for c in q])
         S = None if q[0].second is None else np.concatenate([c.second for c in q])
+        chart = np.concatenate([np.full(len(c.weights), k) for k, c in enumerate(q)])
+        from .orientation import non_orientable_message
+
+        o = self.orientation_report_  # normals of one orientation (orient_atlas)
         return QuadraturePoints(
-            chart=np.concatenate([np.full(len(c.weights), k) for k, c in enumerate(q)]),
-            weights=np.concatenate([c.weights for c in q]),
+            chart=chart, weights=np.concatenate([c.weights for c in q]),
             positions=np.concatenate([c.positions for c in q]),
-            tangents=T, geometry=dg.manifold_geometry(T, S))
+            tangents=T, geometry=dg.manifold_geometry(
+                T, S, orientation=o.signs[chart],
+                unoriented=None if o.orientable else non_orientable_message(o)))
 
     def integrate(self, f: Callable[[QuadraturePoints], np.ndarray], per_chart: bool = False):
         """∫_M f dM ≈ Σ_κ Σ_g w_g J_κ ψ_κ f (thesis §3.4); f gets a :class:`QuadraturePoints`.

@@ -18,6 +18,8 @@ curve), scalar second fundamental form b_αβ = φ_αβ · n, shape operator a^{
 curvature H = tr(a^{-1} b) = Σ κ_i (the thesis convention of the Willmore energy
 ∫H² dA = 16π on a unit sphere, L1085) and Gauss–Kronecker curvature det b / det a = Π κ_i
 (= K for d = 2). The sign of H follows the orientation of n; H² and K do not depend on it.
+The atlas orients its charts alike (:mod:`.orientation`) and passes the chart signs as
+``orientation`` (a factor ±1 on n per point).
 
 :func:`surface_geometry` returns a :class:`Geometry` dict: ``metric`` and ``area_element``
 always, the thesis quantities of a surface in R^3 (``normal``, ``second_fundamental_form``,
@@ -174,14 +176,22 @@ REQUIREMENTS = {
 }
 
 
+#: quantities whose sign follows the orientation of n (refused on a non-orientable manifold;
+#: the Gauss–Kronecker curvature only for odd d, where det(−b) = −det b)
+ORIENTED = ("normal", "second_fundamental_form", "mean_curvature", "principal_curvatures",
+            "gauss_kronecker_curvature")
+
+
 class Geometry(dict):
     """Pointwise geometry at m points; quantities beyond the eager ones are computed on first
     access (module docstring). Asking for one the dimensions or the data do not allow raises
     :class:`InputError` naming what it needs."""
 
-    def __init__(self, T: np.ndarray, S: np.ndarray | None, eager: dict):
+    def __init__(self, T: np.ndarray, S: np.ndarray | None, eager: dict,
+                 orientation: np.ndarray | None = None, unoriented: str | None = None):
         super().__init__(eager)
         self._T, self._S = T, S
+        self._sign, self._unoriented = orientation, unoriented
 
     def __missing__(self, key):
         T, S = self._T, self._S
@@ -196,6 +206,9 @@ class Geometry(dict):
         if not ok:
             raise InputError(f"geometry[{key!r}] needs {REQUIREMENTS[key]}; this manifold has "
                              f"{_dims(T)}.")
+        if self._unoriented and key in ORIENTED and (key != "gauss_kronecker_curvature"
+                                                     or d % 2 == 1):
+            raise InputError(f"geometry[{key!r}] needs an orientation: {self._unoriented}")
         if S is None and key != "normal":
             raise InputError(f"geometry[{key!r}] needs second derivatives of the charts; build "
                              "the quadrature with need_second=True.")
@@ -205,14 +218,18 @@ class Geometry(dict):
     def _compute(self, key: str) -> np.ndarray:
         T, S, a = self._T, self._S, self["metric"]
         if key == "normal":
-            return unit_normal(T)
+            n = unit_normal(T)
+            return n if self._sign is None else n * self._sign[:, None]
         if key == "second_fundamental_form":
             return second_fundamental_form(S, self["normal"])
         if key == "mean_curvature":
             return mean_curvature(a, self["second_fundamental_form"])
         if key == "gauss_kronecker_curvature" or (key == "gaussian_curvature"
                                                   and T.shape[2] == T.shape[1] + 1):
-            return gaussian_curvature(a, self["second_fundamental_form"])
+            # det b is even in n for even d: the unsigned chart normal serves unoriented atlases
+            b = (second_fundamental_form(S, unit_normal(T)) if self._unoriented
+                 else self["second_fundamental_form"])
+            return gaussian_curvature(a, b)
         if key == "principal_curvatures":
             return principal_curvatures(a, self["second_fundamental_form"])
         if key == "vector_second_fundamental_form":
@@ -231,21 +248,30 @@ class Geometry(dict):
         raise KeyError(key)  # pragma: no cover - REQUIREMENTS and _compute agree
 
 
-def surface_geometry(T: np.ndarray, S: np.ndarray | None) -> Geometry:
+def surface_geometry(T: np.ndarray, S: np.ndarray | None, orientation: np.ndarray | None = None,
+                     unoriented: str | None = None) -> Geometry:
     """Pointwise geometry of the chart derivatives T (m, d, D), S (m, d, d, D) or None.
 
     ``metric`` and ``area_element`` (the d-volume element) always; for a surface in R^3 with S
     given also ``normal``, ``second_fundamental_form``, ``mean_curvature`` (H = κ1 + κ2) and
     ``gaussian_curvature`` at once; other quantities (:data:`REQUIREMENTS`) on access.
+
+    orientation : (m,) ±1 multiplying the normal of each point (the atlas's chart signs,
+        :mod:`.orientation`), so n, b and H are those of one orientation; K, H² unchanged.
+    unoriented : on a non-orientable manifold, why: the :data:`ORIENTED` quantities then
+        raise InputError with it, the orientation-free ones are computed as usual.
     """
     a = metric(T)
     eager = {"metric": a, "area_element": np.sqrt(np.clip(np.linalg.det(a), 0.0, None))}
     if S is not None and T.shape[1] == 2 and T.shape[2] == 3:
         n = unit_normal(T)
+        if orientation is not None:
+            n = n * orientation[:, None]
         b = second_fundamental_form(S, n)
-        eager.update(normal=n, second_fundamental_form=b,
-                     mean_curvature=mean_curvature(a, b), gaussian_curvature=gaussian_curvature(a, b))
-    return Geometry(T, S, eager)
+        eager.update(gaussian_curvature=gaussian_curvature(a, b))
+        if not unoriented:
+            eager.update(normal=n, second_fundamental_form=b, mean_curvature=mean_curvature(a, b))
+    return Geometry(T, S, eager, orientation, unoriented)
 
 
 #: the same, under a name that does not suggest d = 2

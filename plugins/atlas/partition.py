@@ -98,19 +98,21 @@ def partition_markers(markers: np.ndarray, n_parts: int, n_neighbors: int = 10
 
 def refine_partition(labels: np.ndarray, adjacency: csr_matrix,
                      acceptable: Callable[[np.ndarray], bool], max_depth: int = 6,
-                     min_size: int = 8) -> tuple[np.ndarray, np.ndarray]:
+                     min_size: int = 8) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Recursively bisect (METIS) every patch for which ``acceptable(marker_indices)`` fails.
 
-    A patch with fewer than 2·min_size markers or at depth max_depth is kept as it is.
-    Returns new labels 0..L'-1 and, per final patch, whether it passed the test.
+    ``acceptable`` may itself repair the patch (re-embed it, :mod:`.chart_repair`); only a
+    patch it still rejects is split. A patch with fewer than 2·min_size markers or at depth
+    max_depth is kept as it is. Returns new labels 0..L'-1 and, per final patch, whether it
+    passed the test and its split depth (0: a patch of the initial partition).
     """
     queue = [(np.flatnonzero(labels == lab), 0) for lab in np.unique(labels)]
-    final: list[tuple[np.ndarray, bool]] = []
+    final: list[tuple[np.ndarray, bool, int]] = []
     while queue:
         idx, depth = queue.pop()
         ok = acceptable(idx)
         if ok or depth >= max_depth or idx.size < 2 * min_size:
-            final.append((idx, ok))
+            final.append((idx, ok, depth))
             continue
         sub = adjacency[idx][:, idx]
         halves = split_disconnected(sub, metis_parts(sub, 2))
@@ -118,9 +120,10 @@ def refine_partition(labels: np.ndarray, adjacency: csr_matrix,
             queue.append((idx[halves == lab], depth + 1))
     out = np.empty_like(labels)
     final.sort(key=lambda item: item[0].min())
-    for k, (idx, _) in enumerate(final):
+    for k, (idx, _, _) in enumerate(final):
         out[idx] = k
-    return out, np.array([ok for _, ok in final], dtype=bool)
+    return (out, np.array([ok for _, ok, _ in final], dtype=bool),
+            np.array([depth for _, _, depth in final], dtype=np.int64))
 
 
 def embedding_defects(points: np.ndarray, xi: np.ndarray, n_neighbors: int = 8

@@ -7,9 +7,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Optional
+from typing import List, Optional
 
 from pointatlas.errors import ConfigError
+
+
+#: markers per patch of a geometry study's atlas (and of an Atlas given None)
+GEOMETRY_MARKERS_PER_PATCH = 150
 
 
 @dataclass
@@ -17,7 +21,8 @@ class AtlasSettings:
     """Numerical parameters of the atlas (thesis Table I / BENCHMARKS.md)."""
 
     n_patches: Optional[int] = None       # None: from markers_per_patch
-    markers_per_patch: int = 150
+    markers_per_patch: Optional[int] = None  # None: the study's choice (150 for geometry,
+    #                                          100 for shells)
     gamma_lme: float = 0.8
     tol_lme: float = 1e-10
     chart_hessians: str = "exact"         # LME Hessians of the charts: 'exact' or 'consistent'
@@ -43,6 +48,12 @@ class AtlasSettings:
     max_distortion: float = 2.5           # ... and this 95th-percentile singular-value ratio
     #                                       of the triangles, with no folds
     max_refinement_depth: int = 6
+    allow_failed_patches: bool = False    # patches failing the chart test after repair
+    #                                       (re-embedding, splitting; chart_repair.py): False
+    #                                       refuses the atlas, True keeps them, flagged
+    orientation: Optional[List[float]] = None  # the side an open surface's normals face
+    #                                       (n·e > 0 on average; orientation.py); None: the
+    #                                       first chart's. Closed surfaces: always outward
 
     @classmethod
     def of(cls, obj) -> "AtlasSettings":
@@ -73,7 +84,18 @@ class AtlasSettings:
             raise ConfigError(f"least_squares_scope = {self.least_squares_scope!r} is invalid; "
                               "use 'chart' (per-chart interpolation) or 'global' (Paper 2 "
                               "App. B: one least-squares fit of the blended atlas).")
-        if self.markers_per_patch < 8:
+        e = self.orientation
+        if e is not None and not (len(e) >= 1 and all(isinstance(v, (int, float))
+                                                       and math.isfinite(v) for v in e)
+                                  and any(v != 0 for v in e)):
+            raise ConfigError(f"orientation = {list(e)!r} is invalid; give a non-zero direction "
+                              "[nx, ny, nz], the side the normals of an open surface face "
+                              "(e.g. [0, 0, 1]), or leave it unset.")
+        if not isinstance(self.allow_failed_patches, bool):
+            raise ConfigError(f"allow_failed_patches = {self.allow_failed_patches!r} is invalid; "
+                              "use true (keep patches whose charts fail, results flagged) or "
+                              "false (refuse such an atlas, the default).")
+        if self.markers_per_patch is not None and self.markers_per_patch < 8:
             raise ConfigError(f"markers_per_patch = {self.markers_per_patch!r} is invalid; "
                               "it must be >= 8 (a patch needs enough markers to be embedded).")
 

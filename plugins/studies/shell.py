@@ -19,11 +19,15 @@ from pointatlas_atlas.settings import AtlasSettings
 from pointatlas.stores_config import stores_config
 
 
+#: markers per patch of a shell's atlas unless atlas.markers_per_patch says otherwise
+SHELL_MARKERS_PER_PATCH = 100
+
+
 @dataclass
 class ShellStudySettings(AtlasSettings):
-    """Atlas parameters (thesis Table I) plus where and against what to read the result."""
+    """Where and against what to read the result. The atlas parameters inherited from
+    :class:`AtlasSettings` are the deprecated ``study.*`` spellings of ``atlas.*``."""
 
-    markers_per_patch: int = 100
     reference_point: List[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
     reference_direction: List[float] = field(default_factory=lambda: [0.0, 0.0, -1.0])
     references: List[float] = field(default_factory=list)
@@ -41,8 +45,24 @@ class ShellStudy:
         "Linear Kirchhoff–Love analysis of a point-set shell: displacement at a reference "
         "point vs published values, deformed shape (.vtp).")
 
-    def atlas_settings(self) -> AtlasSettings:
-        return AtlasSettings.of(self)
+    def atlas_settings(self, ctx=None) -> AtlasSettings:
+        """The run's ``atlas.*`` settings (the old ``study.*`` spellings still honoured, with a
+        deprecation message); shells default to 100 markers per patch."""
+        from pointatlas_atlas.plugin import study_atlas_settings
+
+        return study_atlas_settings(ctx, self, markers_per_patch=SHELL_MARKERS_PER_PATCH)
+
+    def check_config(self) -> None:
+        """Start-up checks: the atlas settings and the magnification of the deformed shape."""
+        import math
+
+        from pointatlas.errors import ConfigError
+
+        self.atlas_settings().check()
+        m = self.magnification
+        if not (isinstance(m, (int, float)) and math.isfinite(m) and m >= 0):
+            raise ConfigError(f"magnification={m!r} is invalid: it must be a finite number >= 0 "
+                              "(0 scales the deformed shape so that max |u| is 10 % of the size).")
 
     def run(self, ctx):
         from pointatlas.errors import ConfigError
@@ -52,14 +72,18 @@ class ShellStudy:
                               f"got physics={ctx.choices.get('physics')!r}.")
         if len(self.reference_labels) not in (0, len(self.references)):
             raise ConfigError("study.reference_labels must name each of study.references.")
-        self.atlas_settings().check()
+        atlas_settings = self.atlas_settings(ctx)
+        atlas_settings.check()
         with ctx.timed("source"):
             cloud = ctx.plugin("source").load(ctx.rng("source"))
         physics = ctx.plugin("physics")
         with ctx.timed("analysis"):
-            ds = physics.solve(ctx, cloud=cloud, atlas_settings=self.atlas_settings())
+            ds = physics.solve(ctx, cloud=cloud, atlas_settings=atlas_settings)
         model = physics.model_
-        return self._results(ctx, ds, model, cloud)
+        out = self._results(ctx, ds, model, cloud)
+        if ds.attrs.get("warnings"):
+            out.attrs["warnings"] = ds.attrs["warnings"]
+        return out
 
     def _results(self, ctx, ds, model, cloud):
         from pointatlas_physics.kirchhoff_love.analysis import displacement_at
@@ -93,6 +117,9 @@ class ShellStudy:
         umax = float(ds["max_displacement"])
         mag = self.magnification or (0.1 * size / umax if umax > 0 else 1.0)
         ds.attrs["magnification"] = mag
+        # the side the normals (and pressures) of the atlas face: 'outward', the user's
+        # atlas.orientation '[nx, ny, nz]', 'first_chart' (not fixed) or 'none' (non-orientable)
+        ds.attrs["normal_orientation"] = str(model.atlas.orientation_)
         ds.attrs["title"] = f"Kirchhoff–Love shell: {cloud.name}, {int(ds['dof'])} DOF"
         if self.write_vtp:
             write_vtp(model, ctx.run_dir / "shell.vtp", mag)

@@ -79,10 +79,13 @@ class ShellNonlinearStudy:
         "or arc-length control; L-BFGS + Newton with line search; step cutting; stability by "
         "pivot signs); load–deflection curves.")
 
-    def atlas_settings(self):
-        from pointatlas_atlas.settings import AtlasSettings
+    def atlas_settings(self, ctx=None):
+        """The run's ``atlas.*`` settings (old ``study.*`` spellings honoured, deprecated)."""
+        from pointatlas_atlas.plugin import study_atlas_settings
 
-        return AtlasSettings.of(self)
+        from .shell import SHELL_MARKERS_PER_PATCH
+
+        return study_atlas_settings(ctx, self, markers_per_patch=SHELL_MARKERS_PER_PATCH)
 
     def check_config(self) -> None:
         """Start-up checks that need no model (run before the run directory is made): the
@@ -137,7 +140,7 @@ class ShellNonlinearStudy:
         settings = run_settings(ctx)
         # checked before the model is built: a wrong resume_from fails in a moment
         history = read_increments(self.resume_from, settings) if self.resume_from else []
-        atlas_settings = self.atlas_settings()
+        atlas_settings = self.atlas_settings(ctx)
         atlas_settings.check()
         with ctx.timed("source"):
             cloud = ctx.plugin("source").load(ctx.rng("source"))
@@ -189,6 +192,9 @@ class ShellNonlinearStudy:
                 ctx.log.error("%s", exc)
         ds = self._dataset(model, records, values, names)
         ds.attrs["stopped"] = stopped or "completed the load path"
+        warning = model.atlas.refinement_warning()  # failed patches, kept by the user's choice
+        if warning:
+            ds.attrs["warnings"] = warning
         return ds
 
     def _check_control(self, F, s) -> None:

@@ -48,8 +48,16 @@ class SurfaceGeometry:
     }
 
 
-    def settings(self):
-        return AtlasSettings.of(self)
+    def settings(self, ctx=None) -> AtlasSettings:
+        """The run's ``atlas.*`` settings (the old ``study.*`` spellings still honoured, with a
+        deprecation message); geometry defaults to 150 markers per patch."""
+        from pointatlas_atlas.plugin import study_atlas_settings
+        from pointatlas_atlas.settings import GEOMETRY_MARKERS_PER_PATCH
+
+        return study_atlas_settings(ctx, self, markers_per_patch=GEOMETRY_MARKERS_PER_PATCH)
+
+    def check_config(self) -> None:
+        self.settings().check()
 
     def build_atlas(self, ctx, cloud):
         from pointatlas_atlas.atlas import Atlas
@@ -62,8 +70,8 @@ class SurfaceGeometry:
                 f"surface_geometry needs a surface (d = 2) in R^3; {cloud.name} has D = "
                 f"{cloud.ambient_dim}, d = {cloud.intrinsic_dim}. Pick a surface source "
                 "(sphere, torus, connected_pipes) or a file of 3-D points on a surface.")
-        check_order(self.quadrature_order)
-        s = self.settings()
+        s = self.settings(ctx)
+        check_order(s.quadrature_order)
         atlas = Atlas(
             s,
             make_embedder=lambda: ctx.plugin("embedder"),
@@ -87,16 +95,34 @@ class SurfaceGeometry:
         return atlas
 
     def run(self, ctx):
-        import xarray as xr
+        """Load and check the cloud (cloud_checks.py: a creased or non-manifold cloud is
+        refused), then one atlas per connected component (:meth:`run_cloud`); several
+        components are reported along dim ``component`` (component_results.py)."""
+        from .component_results import checked_components, combine_components
 
         with ctx.timed("source"):
             cloud = ctx.plugin("source").load(ctx.rng("source"))
+        with ctx.timed("cloud_checks"):
+            parts, comp = checked_components(cloud, self.settings(ctx).graph_neighbors, ctx.log)
+        if len(parts) == 1:
+            ds = self.run_cloud(ctx, parts[0])
+        else:
+            ds = combine_components([self.run_cloud(ctx, part) for part in parts], comp, cloud)
+        ds["n_isolated_points"] = ((), 0 if comp is None else comp.n_isolated, {
+            "long_name": "isolated points dropped (k-NN groups too small for a chart)",
+            "units": "1"})
+        return ds
+
+    def run_cloud(self, ctx, cloud):
+        """Atlas, integrals and per-patch results of one connected smooth cloud."""
+        import xarray as xr
+
         atlas = self.build_atlas(ctx, cloud)
         with ctx.timed("integration"):
             qp = atlas.quadrature_points()
             g = qp.geometry
             integrands = {"area": np.ones(len(qp.weights)),
-                          "willmore_energy": g["mean_curvature"] ** 2,
+                          "willmore_energy": g["mean_curvature_squared"],
                           "total_gaussian_curvature": g["gaussian_curvature"]}
             L = len(atlas.charts_)
             per_patch = {k: np.bincount(qp.chart, weights=v * qp.weights, minlength=L)
@@ -132,7 +158,15 @@ class SurfaceGeometry:
             "max_lost_pu": ((), max(q.lost_pu for q in atlas.quadrature_), {**one, "long_name": (
                 "largest ψ_κ near a Gauss point dropped outside the LME hull (should be ~0)")}),
             "n_unaccepted_patches": ((), int((~atlas.accepted_).sum()), {**one, "long_name": (
-                "patches whose chart still fails the fold/stress/distortion test")}),
+                "patches whose chart still fails the fold/stress/distortion test after repair "
+                "(only with allow_failed_patches; else the run is refused)")}),
+            "unaccepted_weight_fraction": ((), float(per_patch["area"][~atlas.accepted_].sum()
+                                                     / per_patch["area"].sum()),
+                                           {**one, "long_name": (
+                "fraction of the quadrature weight (area) on patches that fail the chart test")}),
+            "patch_embedder": (("patch",), *_embedder_codes(atlas)),
+            "patch_split_depth": (("patch",), atlas.patch_depth_, {**one, "long_name": (
+                "times the patch was bisected after the initial METIS partition (repair)")}),
             "patch_markers": (("patch",), sizes, {**one, "long_name": "markers in the patch"}),
             "patch_accepted": (("patch",), atlas.accepted_.astype(np.int8), {**one, "long_name": (
                 "1 if the patch's chart passed the fold/stress/distortion test")}),
@@ -148,6 +182,9 @@ class SurfaceGeometry:
                         attrs={"title": f"atlas geometry of {cloud.name} ({cloud.n_points} points,"
                                         f" {ctx.plugin_name('embedder')} charts)",
                                "mean_curvature_convention": "H = κ1 + κ2"})
+        warning = atlas.refinement_warning()  # failed patches kept by allow_failed_patches
+        if warning:
+            ds.attrs["warnings"] = warning
         for key in ("area", "willmore_energy", "total_gaussian_curvature"):
             if f"relative_error_{key}" in ds:
                 ctx.log.info("%s = %.10g (exact %.10g, rel. error %.3e)", key, float(ds[key]),
@@ -175,6 +212,18 @@ class SurfaceGeometry:
         fig.suptitle(ds.attrs.get("title", "surface geometry"))
         fig.tight_layout()
         return [("Patches", fig)]
+
+
+def _embedder_codes(atlas) -> tuple[np.ndarray, dict]:
+    """Per patch, the embedder whose chart was used, as CF flag codes (flag_values /
+    flag_meanings in the order the repair tries them, chart_repair.repair_embedders)."""
+    names = list(atlas.repair_embedders_)
+    names += sorted(set(atlas.patch_embedder_) - set(names))   # 'none': never embedded
+    codes = np.array([names.index(n) for n in atlas.patch_embedder_], dtype=np.int8)
+    return codes, {"long_name": "embedder of the patch's chart (the first that passed the "
+                                "chart test; the least bad if none did)", "units": "1",
+                   "flag_values": np.arange(len(names), dtype=np.int8),
+                   "flag_meanings": " ".join(names)}
 
 
 def _units(key: str) -> str:

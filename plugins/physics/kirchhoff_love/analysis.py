@@ -83,8 +83,8 @@ def build_model(cloud, settings, atlas_settings, make_embedder, make_lme, make_p
     markers = cloud.markers if cloud.markers is not None else P
     atlas = Atlas(atlas_settings, make_embedder, make_lme, make_pu)
     with _timed(times, "partition"):
-        atlas.partition(nodes, markers, keep_basis=True)
-    warning = atlas.refinement_warning()
+        atlas.partition(nodes, markers, keep_basis=True)  # AtlasError: charts fail after repair
+    warning = atlas.refinement_warning()  # only with atlas.allow_failed_patches=true
     if warning and log is not None:
         log.warning(warning)
     with _timed(times, "charts"):
@@ -165,7 +165,10 @@ def assemble_loads(model: ShellModel, settings, log=None) -> np.ndarray:
             F += f
         elif ld.kind in ("surface", "pressure"):
             if ld.kind == "pressure" and normals is None:
-                normals = _quadrature_normals(model.quadrature, model.nodes)
+                normals = pressure_normals(model)
+                if log is not None:
+                    log.info("pressure acts along the atlas normals (orientation: %s)",
+                             model.atlas.orientation_)
             F += surface_load(model.quadrature, F.shape[0], ld.force, ld.pressure, normals)
         else:
             F += line_load(model.atlas, model.points, model.boundary, model.curves,
@@ -205,19 +208,32 @@ def regularize_ghosts(K, model: ShellModel, eps: float = 1e-10):
     return (K + diags(ghost_springs(K, model, eps))).tocsr()
 
 
-def _quadrature_normals(q, nodes: np.ndarray) -> np.ndarray:
-    """Unit normals at the quadrature points, oriented away from the centroid of the nodes
-    (charts have their own orientations; a pressure > 0 pushes a closed shell outwards)."""
+def pressure_normals(model: ShellModel) -> np.ndarray:
+    """Unit normals (m, 3) at the shell's quadrature points, of the atlas's one orientation
+    (:mod:`pointatlas_atlas.orientation`): outward on a surface that encloses a volume, along
+    ``atlas.orientation`` (n·e > 0 on average) on an open one. A pressure p is the traction
+    p n: p > 0 pushes a closed shell outwards and an open one towards ``atlas.orientation``.
+
+    Refused (ConfigError) on an open surface whose orientation the user has not fixed (the
+    side would be the first chart's, an accident of the embedding), and (InputError) on a
+    non-orientable cloud.
+    """
+    from pointatlas.errors import ConfigError
+    from pointatlas_atlas.orientation import non_orientable_message
+
+    atlas, q = model.atlas, model.quadrature
+    o = atlas.orientation_report_
+    if not o.orientable:
+        raise InputError(f"a pressure load needs a normal, but {non_orientable_message(o)}")
+    if "first_chart" in o.mode:
+        raise ConfigError(
+            "a pressure load on an open surface needs a fixed orientation: set "
+            "atlas.orientation=[nx, ny, nz], the side the normal n faces (n·e > 0 on average; "
+            "the traction is p n, so p > 0 pushes the surface towards it), e.g. "
+            "atlas.orientation=[0, 0, 1].")
     n = np.cross(q.reference[:, 0], q.reference[:, 1])
     n /= np.linalg.norm(n, axis=1)[:, None]
-    rows = np.repeat(np.arange(len(q.weights)), np.diff(q.indptr))
-    x = np.zeros((len(q.weights), 3))
-    for j in range(3):
-        x[:, j] = np.bincount(rows, weights=q.basis[:, 0] * nodes[q.indices, j],
-                              minlength=len(q.weights))
-    flip = np.einsum("ij,ij->i", n, x - nodes.mean(axis=0)) < 0
-    n[flip] *= -1.0
-    return n
+    return n * atlas.chart_orientation_[q.group][:, None]
 
 
 def displacement_at(model: ShellModel, x) -> tuple[np.ndarray, np.ndarray]:

@@ -73,7 +73,11 @@ class KirchhoffLove:
                             log=ctx.log)
         solve_linear(model, s, log=ctx.log)
         self.model_ = model
-        return field_dataset(model)
+        ds = field_dataset(model)
+        warning = model.atlas.refinement_warning()  # failed patches, kept by the user's choice
+        if warning:
+            ds.attrs["warnings"] = warning
+        return ds
 
 
 def _as_settings(s: ShellSettings) -> ShellSettings:

@@ -16,8 +16,10 @@ Supports (Paper 1 App. D, thesis App. E.2), each on the points a :class:`Selecto
 ========================  ===========================================================
 
 Loads: ``point`` (``force`` vector at the surface point nearest to ``at``), ``surface``
-(``force`` per unit area, e.g. self weight), ``pressure`` (``pressure`` per unit area along
-the unit normal oriented away from the centroid of the points), ``line`` (``force`` per unit length on the boundary points ``where`` picks).
+(``force`` per unit area, e.g. self weight), ``pressure`` (traction ``pressure``·n per unit
+area, with the atlas's one orientation n: outward on a closed surface, towards
+``atlas.orientation`` on an open one, where it is required), ``line`` (``force`` per unit
+length on the boundary points ``where`` picks).
 """
 from __future__ import annotations
 

@@ -110,16 +110,24 @@ def test_bad_settings_raise():
         make_atlas(gamma_pu=-1.0).build(np.random.default_rng(0).standard_normal((50, 3)))
 
 
-def test_refinement_warning_names_the_failing_patches_and_the_fixes(atlas):
+def test_thin_pipe_is_repaired_or_refused_never_silently_folded(atlas):
+    """Today's code accepted the pipe's folded PCA charts with a warning only. Now a patch
+    failing the chart test is re-embedded (Isomap, NLIE), then split; what still fails at the
+    depth limit is refused (AtlasError), unless allow_failed_patches keeps it, flagged."""
+    from pointatlas_atlas.chart_repair import AtlasError
+
     assert atlas.refinement_warning() is None  # the sphere's charts all pass
     rng = np.random.default_rng(1)
     t, z = rng.uniform(0, 2 * np.pi, 600), rng.uniform(-2.0, 2.0, 600)
     thin_pipe = np.column_stack([0.3 * np.cos(t), 0.3 * np.sin(t), z])  # 8 spacings round
-    pipe = make_atlas(markers_per_patch=60, max_refinement_depth=1)
+    with pytest.raises(AtlasError, match=r"^\d+ of \d+ patches of the atlas fail"):
+        make_atlas(markers_per_patch=60, max_refinement_depth=1).partition(thin_pipe)
+    pipe = make_atlas(markers_per_patch=60, max_refinement_depth=1, allow_failed_patches=True)
     pipe.partition(thin_pipe)
     n_bad = int((~pipe.accepted_).sum())
-    assert n_bad > 0  # PCA of a patch wrapped round the pipe folds
+    assert 0 < n_bad < pipe.accepted_.size
+    assert "nlie" in set(pipe.patch_embedder_)           # the repair re-embedded some
     message = pipe.refinement_warning()
-    assert message.startswith(f"{n_bad} of {pipe.accepted_.size} patch(es)")
-    for fix in ("more densely", "chart_margin", "gamma_pu", "isomap"):
+    assert message.startswith(f"{n_bad} of {pipe.accepted_.size} patches")
+    for fix in ("more points", "markers_per_patch", "chart_reproduction=quartic"):
         assert fix in message

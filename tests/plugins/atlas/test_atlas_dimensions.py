@@ -138,7 +138,7 @@ def test_chart_margin_default_depends_on_chart_dimension():
     AtlasSettings(chart_margin=None).check()
     pc = Hypersphere(n_points=400, radius=1.0).load(np.random.default_rng(0))
     atlas = make_atlas(3, markers_per_patch=40, max_refinement_depth=0, max_stress=1.0,
-                       max_distortion=100.0)
+                       max_distortion=100.0, allow_failed_patches=True)  # caps this big fold
     atlas.partition(pc.points)
     assert atlas.chart_dim_ == 3
 

@@ -26,10 +26,10 @@ def _settings(supports=None, loads=None):
             Load(kind="point", at=[0, 0, 0], force=[0, 0, -F / 4])])
 
 
-def _model(settings):
+def _model(settings, orientation=None):
     cloud = pointatlas.load_plugin("sources", "square_plate")(
         n_points=196, model="quarter", length=L).load(np.random.default_rng(0))
-    atlas = AtlasSettings(markers_per_patch=100, quadrature_order=4)
+    atlas = AtlasSettings(markers_per_patch=100, quadrature_order=4, orientation=orientation)
     return build_model(
         cloud, settings, atlas,
         make_embedder=lambda: pointatlas.load_plugin("embedders", "pca")(n_components=2),
@@ -99,7 +99,8 @@ def test_load_off_the_surface_and_empty_selector_are_errors():
 
 
 def test_line_and_pressure_loads_total_their_resultants(solved):
-    from pointatlas_physics.kirchhoff_love.analysis import _quadrature_normals
+    from pointatlas.errors import ConfigError
+    from pointatlas_physics.kirchhoff_love.analysis import pressure_normals
     from pointatlas_physics.kirchhoff_love.loads import line_load, surface_load
 
     model, _ = solved
@@ -107,9 +108,12 @@ def test_line_and_pressure_loads_total_their_resultants(solved):
     f = line_load(model.atlas, model.points, model.boundary, model.curves, edge, [0, 0, -3.0],
                   model.spacing)
     assert f.sum(axis=0) == pytest.approx([0, 0, -3.0 * 5.0], rel=1e-8)  # 3 per length × 5
-    n = _quadrature_normals(model.quadrature, model.nodes)
-    f = surface_load(model.quadrature, model.nodes.shape[0], pressure=2.0, normals=n)
-    assert abs(f.sum(axis=0)[2]) == pytest.approx(2.0 * 25.0, rel=1e-8)
+    with pytest.raises(ConfigError, match="atlas.orientation"):  # open plate, side not fixed
+        pressure_normals(model)
+    down = _model(_settings(), orientation=[0, 0, -1])
+    n = pressure_normals(down)
+    f = surface_load(down.quadrature, down.nodes.shape[0], pressure=2.0, normals=n)
+    np.testing.assert_allclose(f.sum(axis=0), [0, 0, -2.0 * 25.0], rtol=1e-8, atol=1e-10)
 
 
 def test_symmetry_rows_are_exact_under_large_rotation():

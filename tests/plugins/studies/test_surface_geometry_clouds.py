@@ -1,0 +1,122 @@
+"""surface_geometry on clouds that are not one smooth manifold (issue 16, item 4)."""
+import os
+
+import numpy as np
+import pytest
+
+from pointatlas.context import RunContext
+from pointatlas.errors import InputError
+from pointatlas_studies.surface_geometry import SurfaceGeometry
+
+
+def fibonacci_sphere(n, radius=1.0, centre=(0.0, 0.0, 0.0)):
+    i = np.arange(n) + 0.5
+    z = 1 - 2 * i / n
+    phi = np.pi * (1 + 5 ** 0.5) * i
+    r = np.sqrt(1 - z * z)
+    return radius * np.c_[r * np.cos(phi), r * np.sin(phi), z] + np.asarray(centre)
+
+
+def cube_surface(n_side=16):
+    t = (np.arange(n_side) + 0.5) / n_side * 2 - 1
+    u, v = (a.ravel() for a in np.meshgrid(t, t))
+    faces = []
+    for axis in range(3):
+        others = [a for a in range(3) if a != axis]
+        for side in (-1.0, 1.0):
+            F = np.empty((u.size, 3))
+            F[:, axis], F[:, others[0]], F[:, others[1]] = side, u, v
+            faces.append(F)
+    return np.concatenate(faces)
+
+
+def pyvista_file(name):
+    pytest.importorskip("pyvista")
+    from pyvista import examples
+
+    return os.path.join(os.path.dirname(examples.__file__), name)
+
+
+def run_file(tmp_path, path):
+    """The default command on a file: sphere_willmore's study settings, pca embedder."""
+    ctx = RunContext(config={"source": {"path": str(path), "n_points": None}, "study": {}},
+                     choices={"source": "file", "study": "surface_geometry", "embedder": "pca"},
+                     seed=0, run_dir=tmp_path)
+    return SurfaceGeometry().run(ctx)
+
+
+def saved(tmp_path, points):
+    path = tmp_path / "points.npz"
+    np.savez(path, points=points)
+    return path
+
+
+def test_two_spheres_are_reported_per_component(tmp_path):
+    """Two disjoint Fibonacci spheres (radii 1 and 0.7) and 3 stray points: one atlas per
+    sphere, areas 4π and 4π·0.49 per component, totals the sums, the strays counted."""
+    rng = np.random.default_rng(0)
+    stray = rng.uniform(-0.1, 0.1, (3, 3)) + [1.5, 3.0, 0.0]
+    P = np.concatenate([fibonacci_sphere(1500), fibonacci_sphere(1000, 0.7, (3.0, 0, 0)), stray])
+    ds = run_file(tmp_path, saved(tmp_path, P))
+    assert ds.sizes["component"] == 2
+    assert ds["component_n_points"].values.tolist() == [1500, 1000]
+    exact = 4 * np.pi * np.array([1.0, 0.49])
+    assert np.allclose(ds["component_area"].values, exact, rtol=2e-3)
+    assert np.allclose(ds["component_total_gaussian_curvature"].values, 4 * np.pi, rtol=2e-2)
+    assert float(ds["area"]) == pytest.approx(float(ds["component_area"].sum()))
+    assert float(ds["willmore_energy"]) == pytest.approx(
+        float(ds["component_willmore_energy"].sum()))
+    assert int(ds["n_points"]) == 2500 and int(ds["n_isolated_points"]) == 3
+    assert ds.sizes["patch"] == int(ds["n_patches"])
+    assert sorted(set(ds["patch_component"].values.tolist())) == [0, 1]
+    assert float(ds["patch_area"].sum()) == pytest.approx(float(ds["area"]))
+    for v in list(ds.data_vars) + list(ds.coords):
+        assert "long_name" in ds[v].attrs and "units" in ds[v].attrs, v
+
+
+def test_cube_surface_is_refused_for_its_creases(tmp_path):
+    with pytest.raises(InputError, match=r"^points: this cloud has creases; the curvature "
+                                         r"integrals of a smooth atlas do not apply there: "
+                                         r"384 points on creases \(of 1536\), e\.g\. near \("):
+        run_file(tmp_path, saved(tmp_path, cube_surface(16)))
+
+
+@pytest.mark.parametrize("name, match", [
+    ("nut.ply", r"nut: this cloud has creases; .*: 370 points on creases \(of 523\)"),
+    ("ant.ply", r"ant: this cloud has creases; .* with neighbourhoods that are not a disc"),
+    ("airplane.ply", r"airplane: this cloud is too unevenly sampled for one chart scale: "
+                     r"718 of its 1335 points are isolated"),
+])
+def test_pyvista_meshes_that_are_not_one_smooth_surface_are_refused(tmp_path, name, match):
+    with pytest.raises(InputError, match=match) as info:
+        run_file(tmp_path, pyvista_file(name))
+    assert "\n" not in str(info.value)
+
+
+def test_pyvista_sphere_passes_the_checks_unchanged():
+    """sphere.ply (422 uneven points): not refused, one component, nothing dropped, the
+    cloud handed on as read."""
+    from pointatlas_sources.point_file import PointFile
+    from pointatlas_studies.component_results import checked_components
+
+    cloud = PointFile(path=pyvista_file("sphere.ply")).load()
+    parts, comp = checked_components(cloud, 10)
+    assert parts == [cloud] and comp.n_isolated == 0 and comp.sizes.tolist() == [422]
+
+
+@pytest.mark.slow
+def test_pyvista_sphere_is_accepted(tmp_path):
+    """The whole run on sphere.ply (its figures are the atlas' business: issue 16, item 1;
+    34 s here with the repair loop)."""
+    ds = run_file(tmp_path, pyvista_file("sphere.ply"))
+    assert int(ds["n_points"]) == 422 and int(ds["n_isolated_points"]) == 0
+    assert "component" not in ds.dims
+
+
+def test_generated_sphere_keeps_its_figures(tmp_path):
+    ctx = RunContext(config={"source": {"n_points": 800}, "study": {}},
+                     choices={"source": "sphere", "study": "surface_geometry", "embedder": "pca"},
+                     seed=0, run_dir=tmp_path)
+    ds = SurfaceGeometry().run(ctx)
+    assert int(ds["n_isolated_points"]) == 0 and "cloud_checks" in ctx.timings
+    assert float(ds["relative_error_willmore_energy"]) < 3e-3

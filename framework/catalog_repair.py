@@ -158,12 +158,17 @@ def rebuild_catalog(root: str | Path) -> RepairReport:
 
 
 def collect_garbage(root: str | Path) -> list[Path]:
-    """Remove the temporary files of interrupted writes under ``root`` (not those of a run
-    whose process is still alive on this host); return the removed paths."""
+    """Remove the temporary files of interrupted writes under ``root`` and in the run
+    directories its catalog names (not those of a run whose process is still alive on this
+    host); return the removed paths."""
     from .liveness import hostname
 
     removed = []
-    for run_dir in {p.parent for pattern in PARTIAL_PATTERNS for p in Path(root).rglob(pattern)}:
+    dirs = {p.parent for pattern in PARTIAL_PATTERNS for p in Path(root).rglob(pattern)}
+    # run directories outside the root (hydra.run.dir elsewhere) are known from the catalog
+    dirs |= {Path(r.path) for r in _readable_records(catalog_path(Path(root)))
+             if r.path and Path(r.path).is_dir()}
+    for run_dir in dirs:
         meta = run_dir / RUN_FILE
         try:
             info = json.loads(meta.read_text()) if meta.is_file() else {}

@@ -113,10 +113,33 @@ class SurfaceGeometry:
             "units": "1"})
         return ds
 
+    def _refuse_irregular_curvature(self, ctx, cloud) -> None:
+        """Second derivatives of plain LME charts are not consistent on irregular nodes (README
+        "Known limits": Willmore 64 % off on a random sphere): refuse curvature integrals
+        there unless the charts are made for it (quartic fit, or consistent Hessians)."""
+        from pointatlas_atlas.cloud_checks import IRREGULAR_SPACING, spacing_variation
+
+        from pointatlas.errors import InputError
+
+        s = self.settings(ctx)
+        if s.chart_reproduction != "linear" or s.chart_hessians != "exact":
+            return
+        variation = spacing_variation(cloud.points)
+        if variation > IRREGULAR_SPACING:
+            raise InputError(
+                f"{cloud.name}: the points are irregularly spaced (nearest-neighbour distances "
+                f"vary by {100 * variation:.0f} %, above {100 * IRREGULAR_SPACING:.0f} %): "
+                "the curvatures of plain LME charts are not reliable there (README, Known "
+                "limits). Use the polynomial-fit charts: atlas.chart_reproduction=quartic "
+                "(experiment=sphere_willmore_random adds atlas.least_squares_fit=false "
+                "atlas.chart_margin=5 atlas.gamma_pu=2), or a quasi-uniform subset "
+                "(source.n_points=<fewer>).")
+
     def run_cloud(self, ctx, cloud):
         """Atlas, integrals and per-patch results of one connected smooth cloud."""
         import xarray as xr
 
+        self._refuse_irregular_curvature(ctx, cloud)
         atlas = self.build_atlas(ctx, cloud)
         with ctx.timed("integration"):
             qp = atlas.quadrature_points()

@@ -168,3 +168,13 @@ def test_a_corrupt_results_file_is_one_line(tmp_path, run_cli, content):
     proc = run_cli("pointatlas-report", str(tmp_path / "run"), cwd=tmp_path)
     assert proc.returncode == 1 and "results.nc" in one_line(proc.stderr)
     assert not (tmp_path / "run" / "report.html").exists()
+
+
+def test_gc_finds_run_directories_outside_the_root_through_the_catalog(tmp_path, run_cli):
+    proc = run_cli("pointatlas", "~experiment", "study=embedding", "embedder=pca",
+                   "source.n_points=300", f"hydra.run.dir={tmp_path}/elsewhere", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    (tmp_path / "elsewhere" / ".results.nc.x1y2.tmp").write_bytes(b"x")
+    gc = run_cli("pointatlas-runs", "gc", cwd=tmp_path)
+    assert gc.returncode == 0 and "removed 1 " in gc.stdout
+    assert not (tmp_path / "elsewhere" / ".results.nc.x1y2.tmp").exists()

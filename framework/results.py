@@ -90,9 +90,17 @@ def write_results(ds: xr.Dataset, path: str | os.PathLike, attrs: dict | None = 
     out.attrs = clean_attrs({**ds.attrs, **(attrs or {}), "pointatlas_schema": SCHEMA_VERSION})
     for name in list(out.variables):
         out[name].attrs = clean_attrs(out[name].attrs)
+    return write_netcdf_atomic(out, path)
+
+
+def write_netcdf_atomic(ds: xr.Dataset, path: str | os.PathLike) -> Path:
+    """Write ``ds`` to ``path`` durably: a temporary file beside it (umask mode), fsync,
+    rename over ``path``, fsync of the directory; a kill at any moment leaves the old file or
+    the new one, and at worst a ``.<name>.*.tmp`` leftover (:func:`remove_partial_files`)."""
+    path = Path(path)
     tmp = _temporary_name(path)
     try:
-        out.to_netcdf(tmp, engine="netcdf4")
+        ds.to_netcdf(tmp, engine="netcdf4")
         _publish(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)

@@ -237,12 +237,17 @@ def _cmd_compare(catalog: Catalog, args: argparse.Namespace) -> str:
     return "\n\n".join(sections)
 
 
-def _cmd_repair(args: argparse.Namespace) -> str:
-    from .catalog_repair import rebuild_catalog
-
+def _existing_root(args: argparse.Namespace) -> Path:
     root = _root(args.root)
     if not root.is_dir():
         raise PointatlasError(f"no outputs root at {root}: pass --root <the outputs_root of your runs>")
+    return root
+
+
+def _cmd_repair(args: argparse.Namespace) -> str:
+    from .catalog_repair import rebuild_catalog
+
+    root = _existing_root(args)
     report = rebuild_catalog(root)
     if args.format == "json":
         return _json({"catalog": str(catalog_path(root)), "moved_aside": list(map(str, report.moved_aside)),
@@ -255,9 +260,7 @@ def _cmd_repair(args: argparse.Namespace) -> str:
 def _cmd_gc(args: argparse.Namespace) -> str:
     from .catalog_repair import collect_garbage
 
-    root = _root(args.root)
-    if not root.is_dir():
-        raise PointatlasError(f"no outputs root at {root}: pass --root <the outputs_root of your runs>")
+    root = _existing_root(args)
     removed = collect_garbage(root)
     if args.format == "json":
         return _json({"removed": list(map(str, removed))})

@@ -17,13 +17,13 @@ the first differing key (:func:`check_settings`).
 from __future__ import annotations
 
 import json
-import os
-import uuid
 from pathlib import Path
 
 import numpy as np
 
 from pointatlas.errors import ConfigError, InputError
+from pointatlas.results import write_netcdf_atomic
+from pointatlas.run_files import remove_partial_files
 
 NAME = "increments.nc"
 #: what interrupted writes of increments.nc leave (this module's and older versions')
@@ -33,16 +33,9 @@ ONE = {"units": "1"}
 
 
 def remove_leftovers(run_dir) -> list[Path]:
-    """Delete the temporary files interrupted writes of increments.nc left in ``run_dir``."""
-    folder = Path(run_dir)
-    removed = []
-    if folder.is_dir():
-        for pattern in LEFTOVERS:
-            for leftover in folder.glob(pattern):
-                if leftover.is_file():
-                    leftover.unlink(missing_ok=True)
-                    removed.append(leftover)
-    return removed
+    """Delete the temporary files interrupted writes (of increments.nc, results.nc...) left in
+    ``run_dir`` (:data:`pointatlas.run_files.PARTIAL_PATTERNS` covers :data:`LEFTOVERS`)."""
+    return remove_partial_files(run_dir)
 
 
 def run_settings(ctx, exclude=("study.resume_from",)) -> dict:
@@ -82,25 +75,7 @@ def write_increments(path: Path, ds, records, settings: dict) -> None:
     ds = _with_states(ds, [r.state for r in records])
     ds.attrs.update(resume_settings=json.dumps(settings, sort_keys=True),
                     increments_format=FORMAT)
-    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex[:12]}.tmp")
-    try:
-        ds.to_netcdf(tmp, engine="netcdf4")
-        with open(tmp, "rb") as fh:
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-    try:
-        folder = os.open(path.parent, os.O_RDONLY)
-    except OSError:
-        return
-    try:
-        os.fsync(folder)
-    except OSError:
-        pass
-    finally:
-        os.close(folder)
+    write_netcdf_atomic(ds, path)
 
 
 def _with_states(ds, states):

@@ -80,12 +80,16 @@ def test_genus_two_thin_tube_with_the_default_command(tmp_path, run_cli):
     assert euler == -2                                     # genus 2
     path = tmp_path / "figure_eight.npz"
     np.savez(path, points=X)
-    out = run_cli("pointatlas", "source=file", f"source.path={path}", "source.n_points=null",
-                  f"outputs_root={tmp_path}", cwd=tmp_path)
+    out = run_cli("pointatlas", "source=file", f"source.path={path}",
+                  f"outputs_root={tmp_path}", cwd=tmp_path)   # the default command
     assert out.returncode == 0, out.stderr[-2000:]
     import xarray as xr
 
     ds = xr.open_dataset(next(tmp_path.glob("runs/*/*/results.nc")))
+    print(f"genus-2 tube: int K {float(ds['total_gaussian_curvature']):.5f} (-4pi), area "
+          f"{float(ds['area']):.5f} (marching cubes {reference:.5f}), "
+          f"{int(ds['n_unaccepted_patches'])} failed patches, {float(ds.attrs['wall_time_s']):.1f} s")
+    assert int(ds["source_points_used"]) == 6000
     assert int(ds["n_unaccepted_patches"]) == 0
     assert float(ds["total_gaussian_curvature"]) == pytest.approx(-4 * np.pi, rel=2e-2)
     assert float(ds["area"]) == pytest.approx(reference, rel=5e-3)

@@ -21,7 +21,7 @@ import numpy as np
 import xarray as xr
 
 from .errors import InputError, SchemaError
-from .run_files import PARTIAL_PATTERNS, RESULTS_NAME, remove_partial_files  # noqa: F401
+from .run_files import RESULTS_NAME
 
 SCHEMA_VERSION = 1
 REQUIRED_ATTRS = (

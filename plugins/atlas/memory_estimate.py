@@ -119,12 +119,12 @@ def available_memory_bytes() -> tuple[int, str]:
     found = []
     soft, _ = resource.getrlimit(resource.RLIMIT_AS)
     if soft != resource.RLIM_INFINITY:
-        used = _status_kib("VmSize") * 1024
+        used = (_proc_kib("/proc/self/status", "VmSize") or 0) * 1024
         found.append((max(soft - used, 0), f"the address-space limit (ulimit -v {soft // 1024})"))
     cgroup = _cgroup_free()
     if cgroup is not None:
         found.append((cgroup, "the cgroup memory limit (memory.max)"))
-    meminfo = _meminfo_kib("MemAvailable")
+    meminfo = _proc_kib("/proc/meminfo", "MemAvailable")
     if meminfo is not None:
         found.append((meminfo * 1024, "the memory available on this machine (MemAvailable)"))
     return min(found) if found else (sys.maxsize, "no limit found")
@@ -148,20 +148,10 @@ def format_bytes(n: float) -> str:
     raise AssertionError("unreachable")
 
 
-def _status_kib(key: str) -> int:
-    """A 'kB' field of /proc/self/status (0 where there is no /proc)."""
+def _proc_kib(path: str, key: str) -> int | None:
+    """A 'kB' field (``key: N kB``) of a /proc file; None where there is no such field."""
     try:
-        for line in Path("/proc/self/status").read_text().splitlines():
-            if line.startswith(key + ":"):
-                return int(line.split()[1])
-    except (OSError, ValueError, IndexError):
-        pass
-    return 0
-
-
-def _meminfo_kib(key: str) -> int | None:
-    try:
-        for line in Path("/proc/meminfo").read_text().splitlines():
+        for line in Path(path).read_text().splitlines():
             if line.startswith(key + ":"):
                 return int(line.split()[1])
     except (OSError, ValueError, IndexError):

@@ -8,7 +8,7 @@ so that ``study.resume_from`` continues the path exactly (:func:`read_increments
 is written under a temporary name in the same directory (``.increments.nc.<random>.tmp``),
 flushed to disk, renamed over ``increments.nc`` and the directory is flushed too: a kill at
 any moment leaves the previous complete file or the new one, never a partial one, and
-:func:`remove_leftovers` deletes what an interrupted write left.
+:func:`pointatlas.run_files.remove_partial_files` deletes what an interrupted write left.
 
 The settings the path depends on (the plugins chosen, their configs, the seed) are stored in
 the attribute ``resume_settings`` (JSON); a resume whose settings differ is refused, naming
@@ -27,15 +27,8 @@ from pointatlas.run_files import remove_partial_files
 
 NAME = "increments.nc"
 #: what interrupted writes of increments.nc leave (this module's and older versions')
-LEFTOVERS = (".increments.nc.*.tmp", "increments.partial.nc")
 FORMAT = 2   # 2: with the path state (format 1 files had only the displacements)
 ONE = {"units": "1"}
-
-
-def remove_leftovers(run_dir) -> list[Path]:
-    """Delete the temporary files interrupted writes (of increments.nc, results.nc...) left in
-    ``run_dir`` (:data:`pointatlas.run_files.PARTIAL_PATTERNS` covers :data:`LEFTOVERS`)."""
-    return remove_partial_files(run_dir)
 
 
 def run_settings(ctx, exclude=("study.resume_from",)) -> dict:
@@ -130,7 +123,7 @@ def read_increments(run_dir, settings: dict):
     import xarray as xr
 
     path = check_resume_dir(run_dir)
-    remove_leftovers(path.parent)
+    remove_partial_files(path.parent)
     try:
         old = xr.load_dataset(path, engine="netcdf4")
     except Exception as exc:   # netCDF raises OSError, ValueError, RuntimeError, KeyError

@@ -131,12 +131,14 @@ class ShellNonlinearStudy:
 
         from pointatlas.errors import ConfigError
 
-        from .increment_store import read_increments, remove_leftovers, run_settings
+        from pointatlas.run_files import remove_partial_files
+
+        from .increment_store import read_increments, run_settings
 
         if ctx.plugin_name("physics") != "kirchhoff_love":
             raise ConfigError("study=shell_nonlinear needs physics=kirchhoff_love.")
         P, E, names = self._monitors()
-        remove_leftovers(ctx.run_dir)
+        remove_partial_files(ctx.run_dir)  # the study may run outside run_study (tests)
         settings = run_settings(ctx)
         # checked before the model is built: a wrong resume_from fails in a moment
         history = read_increments(self.resume_from, settings) if self.resume_from else []

@@ -4,25 +4,19 @@ import pytest
 
 import pointatlas
 from pointatlas.errors import ConfigError
-from pointatlas_atlas.atlas import Atlas, AtlasSettings
+from pointatlas_atlas.atlas import AtlasSettings
 from pointatlas_atlas.chart_repair import AtlasError, repair_neighbors
 from pointatlas_atlas.partition import embedding_defects, refine_partition
 
+from .test_atlas import make_atlas as _make_atlas
 from .implicit_surfaces import sample_level_set, torus_tube
 
 R, r = 1.0, 0.25     # a thin torus: 2 000 quasi-uniform points put 29 spacings round the tube
 
 
+
 def make_atlas(**kw):
-    s = AtlasSettings(**{"markers_per_patch": 150, **kw})
-    return Atlas(
-        s,
-        make_embedder=lambda: pointatlas.load_plugin("embedders", "pca")(n_components=2),
-        make_lme=lambda: pointatlas.load_plugin("approximants", "lme")(
-            gamma=s.gamma_lme, tol=s.tol_lme, outside="flag"),
-        make_pu=lambda: pointatlas.load_plugin("approximants", "shepard")(
-            gamma=s.gamma_pu, tol=s.tol_pu, outside="flag"),
-    )
+    return _make_atlas(**{"markers_per_patch": 150, **kw})
 
 
 @pytest.fixture(scope="module")

@@ -4,21 +4,13 @@ band (issue 16, item 3)."""
 import numpy as np
 import pytest
 
-import pointatlas
 from pointatlas.errors import ConfigError, InputError
-from pointatlas_atlas.atlas import Atlas, AtlasSettings
+from pointatlas_atlas.atlas import AtlasSettings
 from pointatlas_atlas.orientation import frame_vectors, orient_charts
 
+from .test_atlas import make_atlas
 
-def make_atlas(**kw):
-    s = AtlasSettings(**kw)
-    return Atlas(
-        s,
-        make_embedder=lambda: pointatlas.load_plugin("embedders", "pca")(n_components=2),
-        make_lme=lambda: pointatlas.load_plugin("approximants", "lme")(
-            gamma=s.gamma_lme, tol=s.tol_lme, outside="flag"),
-        make_pu=lambda: pointatlas.load_plugin("approximants", "shepard")(
-            gamma=s.gamma_pu, tol=s.tol_pu, outside="flag"))
+
 
 
 def rotation(seed=0):

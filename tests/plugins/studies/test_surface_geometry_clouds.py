@@ -8,6 +8,8 @@ from pointatlas.context import RunContext
 from pointatlas.errors import InputError
 from pointatlas_studies.surface_geometry import SurfaceGeometry
 
+from ..atlas.test_cloud_checks import cube_surface
+
 
 def fibonacci_sphere(n, radius=1.0, centre=(0.0, 0.0, 0.0)):
     i = np.arange(n) + 0.5
@@ -17,17 +19,6 @@ def fibonacci_sphere(n, radius=1.0, centre=(0.0, 0.0, 0.0)):
     return radius * np.c_[r * np.cos(phi), r * np.sin(phi), z] + np.asarray(centre)
 
 
-def cube_surface(n_side=16):
-    t = (np.arange(n_side) + 0.5) / n_side * 2 - 1
-    u, v = (a.ravel() for a in np.meshgrid(t, t))
-    faces = []
-    for axis in range(3):
-        others = [a for a in range(3) if a != axis]
-        for side in (-1.0, 1.0):
-            F = np.empty((u.size, 3))
-            F[:, axis], F[:, others[0]], F[:, others[1]] = side, u, v
-            faces.append(F)
-    return np.concatenate(faces)
 
 
 def pyvista_file(name):

@@ -8,8 +8,11 @@ and the fix, and leaves nothing behind:
   attribute take);
 - ``outputs_root``: a directory, or a path that can become one;
 - every selected plugin: built from its config (a ``ValueError``/``TypeError`` from its
-  ``__init__`` becomes the same one-line error), then its ``check_config()`` if it has one
-  (the parameter checks that need no data: ``n_points >= 4``, a positive radius...).
+  ``__init__`` becomes the same one-line error), then checked by
+  :func:`check_plugin_settings`: the parameter constraints its ``Config`` declares
+  (:mod:`pointatlas.constraints`: ``n_points >= 4``, a positive radius, a choice among
+  options, no NaN), then its ``check_config()`` if it has one (rules that tie settings
+  together, files that must exist).
 """
 from __future__ import annotations
 
@@ -17,6 +20,7 @@ import re
 from pathlib import Path
 from typing import Any, Mapping
 
+from .constraints import validate_parameters
 from .errors import ConfigError, PointatlasError
 from .registry import FAMILIES, load_plugin
 
@@ -52,6 +56,15 @@ def _prefixed(family: str, fields: set[str], message: str) -> str:
     return f"{family}: {message}"
 
 
+def check_plugin_settings(plugin: Any, prefix: str = "") -> None:
+    """The start-up check of a built plugin: the constraints its Config declares, each
+    invalid value named ``<prefix>.<key>``, then its ``check_config()`` if it has one."""
+    validate_parameters(plugin, prefix=prefix)
+    check = getattr(plugin, "check_config", None)
+    if callable(check):
+        check()
+
+
 def build_checked(family: str, name: str, kwargs: Mapping[str, Any]):
     """The plugin ``name`` of ``family`` built from ``kwargs`` and checked; ConfigError naming
     ``family.key`` otherwise."""
@@ -62,9 +75,7 @@ def build_checked(family: str, name: str, kwargs: Mapping[str, Any]):
     fields = {f.name for f in dataclasses.fields(config)} if config else set()
     try:
         plugin = cls(**dict(kwargs))
-        check = getattr(plugin, "check_config", None)
-        if callable(check):
-            check()
+        check_plugin_settings(plugin, prefix=family)
     except PointatlasError as exc:
         if isinstance(exc, ValueError):  # ConfigError, InputError
             raise ConfigError(_prefixed(family, fields, str(exc))) from None
@@ -88,4 +99,5 @@ def check_run_config(config: Mapping[str, Any], choices: Mapping[str, str]) -> N
         build_checked(family, name, node)
 
 
-__all__ = ["check_run_config", "check_seed", "check_outputs_root", "build_checked"]
+__all__ = ["check_run_config", "check_seed", "check_outputs_root", "build_checked",
+           "check_plugin_settings"]

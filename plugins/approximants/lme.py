@@ -14,19 +14,18 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from pointatlas.basis import BasisFunctions
-from pointatlas.errors import ConfigError, InputError
+from pointatlas.constraints import Interval, Options, validate_parameters
+from pointatlas.errors import InputError
 from pointatlas.stores_config import stores_config
 
 from . import lme_kernels as K
 from .lme_kernel_2d import lme_kernel_2d
 from .support import SupportGrid, locality, nodal_spacing, support_radius
 from .validation import (
+    LOCALITY_CONSTRAINTS,
     check_nodes,
     check_order,
-    check_outside,
     check_points,
-    check_positive,
-    check_tol,
     compact_rows,
     replace_rows,
     spacing_neighbors,
@@ -81,44 +80,19 @@ class LocalMaxEnt:
         hessians: str = "exact"
         reproduction: str = "linear"
 
+        parameter_constraints: ClassVar[dict[str, list]] = {
+            **LOCALITY_CONSTRAINTS,
+            "newton_tol": [Interval(float, 0, None, closed="neither")],
+            "max_iter": [Interval(int, 1, None)],
+            "hessians": [Options(("exact", "consistent"))],
+            "reproduction": [Options(("linear", *POLYNOMIAL_DEGREE))],
+        }
+
     description: ClassVar[str] = "Local max-ent basis functions (nodal locality β_a = γ/h_a²)."
-    parameter_constraints: ClassVar[dict[str, str]] = {
-        "gamma": "float > 0",
-        "tol": "float in (0, 1)",
-        "n_spacing_neighbors": "int >= 1 and < number of nodes, or None (2*d)",
-        "newton_tol": "float > 0",
-        "max_iter": "int >= 1",
-        "outside": "'error' or 'flag'",
-        "hessians": "'exact' or 'consistent'",
-        "reproduction": "'linear', 'quadratic', 'cubic' or 'quartic'",
-    }
-
-
-    def _check_config(self):
-        name = "LocalMaxEnt"
-        check_positive("gamma", self.gamma, plugin=name)
-        check_tol(self.tol, plugin=name)
-        check_positive("newton_tol", self.newton_tol, plugin=name)
-        check_outside(self.outside, plugin=name)
-        if self.hessians not in ("exact", "consistent"):
-            raise ConfigError(
-                f"LocalMaxEnt: hessians = {self.hessians!r} is invalid; use 'exact' (∂²p_a) or "
-                "'consistent' (second-order consistent, for curvatures on irregular nodes).")
-        if self.reproduction not in ("linear", *POLYNOMIAL_DEGREE):
-            raise ConfigError(
-                f"LocalMaxEnt: reproduction = {self.reproduction!r} is invalid; use 'linear' "
-                "(the LME basis) or 'quadratic', 'cubic', 'quartic' (the polynomial fit of "
-                "that degree on the LME support, for geometry on irregular points).")
-        if isinstance(self.max_iter, bool) or not isinstance(self.max_iter, int) \
-                or self.max_iter < 1:
-            raise ConfigError(
-                f"LocalMaxEnt: max_iter = {self.max_iter!r} is invalid; it must be an integer "
-                ">= 1. Use e.g. max_iter=100."
-            )
 
     def fit(self, nodes) -> "LocalMaxEnt":
         """Store the (n, d) nodes; compute h_a, β_a = γ/h_a², cut-off radii and cell lists."""
-        self._check_config()
+        validate_parameters(self)
         X = check_nodes(nodes, plugin="LocalMaxEnt")
         n, d = X.shape
         k = spacing_neighbors(self.n_spacing_neighbors, d, n, plugin="LocalMaxEnt")
@@ -142,7 +116,7 @@ class LocalMaxEnt:
         """p_a at the (m, d) points, with gradients (order ≥ 1) and Hessians (order 2)."""
         if not hasattr(self, "nodes_"):
             raise InputError("LocalMaxEnt.evaluate called before fit; call fit(nodes) first.")
-        self._check_config()
+        validate_parameters(self)
         order = check_order(order, 2, plugin="LocalMaxEnt")
         d = self.nodes_.shape[1]
         x = check_points(points, d, plugin="LocalMaxEnt")

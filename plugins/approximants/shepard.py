@@ -20,17 +20,16 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from pointatlas.basis import BasisFunctions
+from pointatlas.constraints import validate_parameters
 from pointatlas.errors import InputError
 from pointatlas.stores_config import stores_config
 
 from .support import SupportGrid, locality, nodal_spacing, scan, support_radius
 from .validation import (
+    LOCALITY_CONSTRAINTS,
     check_nodes,
     check_order,
-    check_outside,
     check_points,
-    check_positive,
-    check_tol,
     compact_rows,
     spacing_neighbors,
 )
@@ -120,23 +119,13 @@ class Shepard:
         n_spacing_neighbors: Optional[int] = None
         outside: str = "error"
 
+        parameter_constraints: ClassVar[dict[str, list]] = LOCALITY_CONSTRAINTS
+
     description: ClassVar[str] = "Gaussian Shepard partition of unity (nodal β_a = γ/h_a²)."
-    parameter_constraints: ClassVar[dict[str, str]] = {
-        "gamma": "float > 0",
-        "tol": "float in (0, 1)",
-        "n_spacing_neighbors": "int >= 1 and < number of nodes, or None (2*D)",
-        "outside": "'error' or 'flag'",
-    }
-
-
-    def _check_config(self):
-        check_positive("gamma", self.gamma, plugin="Shepard")
-        check_tol(self.tol, plugin="Shepard")
-        check_outside(self.outside, plugin="Shepard")
 
     def fit(self, nodes) -> "Shepard":
         """Store the (n, D) nodes; compute h_a, β_a, cut-off radii and cell lists."""
-        self._check_config()
+        validate_parameters(self)
         X = check_nodes(nodes, plugin="Shepard", min_nodes=2)
         n, dim = X.shape
         k = spacing_neighbors(self.n_spacing_neighbors, dim, n, plugin="Shepard")
@@ -151,7 +140,7 @@ class Shepard:
         """ψ_a at the (m, D) points, with gradients (order ≥ 1) and Hessians (order 2)."""
         if not hasattr(self, "nodes_"):
             raise InputError("Shepard.evaluate called before fit; call fit(nodes) first.")
-        self._check_config()
+        validate_parameters(self)
         order = check_order(order, 2, plugin="Shepard")
         dim = self.nodes_.shape[1]
         x = check_points(points, dim, plugin="Shepard")

@@ -1,51 +1,30 @@
-"""Checks shared by the approximants: configuration values, node sets, evaluation points."""
+"""Checks shared by the approximants: the parameter constraints their Configs share
+(checked by :func:`pointatlas.constraints.validate_parameters` in ``fit``/``evaluate`` and at
+start-up), the rules that need the nodes, node sets, evaluation points."""
 from __future__ import annotations
-
-import math
 
 import numpy as np
 
+from pointatlas.constraints import Interval, Options
 from pointatlas.errors import ConfigError, InputError
 from pointatlas.pointcloud import check_distinct, validate_points
 
 OUTSIDE_CHOICES = ("error", "flag")
 
-
-def check_positive(name: str, value, *, plugin: str) -> float:
-    if not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
-        raise ConfigError(
-            f"{plugin}: {name} = {value!r} is invalid; it must be a finite number > 0. "
-            f"Set e.g. {name}=0.8."
-        )
-    return float(value)
-
-
-def check_tol(value, *, plugin: str) -> float:
-    if not isinstance(value, (int, float)) or not 0.0 < value < 1.0:
-        raise ConfigError(
-            f"{plugin}: tol = {value!r} is invalid; it is the weight below which a node is "
-            "dropped and must lie in (0, 1). Use e.g. tol=1e-10."
-        )
-    return float(value)
-
-
-def check_outside(value, *, plugin: str) -> str:
-    if value not in OUTSIDE_CHOICES:
-        raise ConfigError(
-            f"{plugin}: outside = {value!r} is invalid; choose 'error' (raise on points "
-            "outside the domain) or 'flag' (mark them in BasisFunctions.outside)."
-        )
-    return value
+#: nodal locality β_a = γ/h_a², support cut-off, nodal spacing h_a, points outside the domain
+LOCALITY_CONSTRAINTS = {
+    "gamma": [Interval(float, 0, None, closed="neither")],
+    "tol": [Interval(float, 0, 1, closed="neither")],
+    # None: 2·d; below the number of nodes (checked in fit, :func:`spacing_neighbors`)
+    "n_spacing_neighbors": [Interval(int, 1, None), None],
+    "outside": [Options(OUTSIDE_CHOICES)],
+}
 
 
 def spacing_neighbors(value, dim: int, n_nodes: int, *, plugin: str) -> int:
-    """The number of neighbours defining h_a: ``value`` or, if None, 2·d (exact on grids)."""
-    k = 2 * dim if value is None else value
-    if isinstance(k, bool) or not isinstance(k, int) or k < 1:
-        raise ConfigError(
-            f"{plugin}: n_spacing_neighbors = {value!r} is invalid; it must be an integer >= 1 "
-            "(or None for 2*d). Set e.g. n_spacing_neighbors=4."
-        )
+    """The number of neighbours defining h_a: ``value`` (an integer >= 1, declared in
+    :data:`LOCALITY_CONSTRAINTS`) or, if None, 2·d (exact on grids); fewer than the nodes."""
+    k = 2 * dim if value is None else int(value)
     if k >= n_nodes:
         raise InputError(
             f"{plugin}: n_spacing_neighbors = {k} needs more than {k} nodes, got {n_nodes}. "

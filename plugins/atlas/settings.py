@@ -1,15 +1,20 @@
 """Numerical parameters of an atlas (thesis Table I, BENCHMARKS.md), with their checks.
 
 Kept free of numpy/scipy imports: it is also the ``Config`` of the surface_geometry study,
-imported at start-up to register configs.
+imported at start-up to register configs. Each value's range is declared in
+``AtlasSettings.parameter_constraints`` (:mod:`pointatlas.constraints`).
 """
 from __future__ import annotations
 
-import math
+import dataclasses
 from dataclasses import dataclass
-from typing import List, Optional
+from typing import ClassVar, List, Optional
 
+from pointatlas.constraints import Each, Interval, Options, Types, validate_parameters
 from pointatlas.errors import ConfigError
+
+_POSITIVE = [Interval(float, 0, None, closed="neither")]
+_FRACTION = [Interval(float, 0, 1, closed="neither")]
 
 
 #: markers per patch of a geometry study's atlas (and of an Atlas given None)
@@ -55,49 +60,40 @@ class AtlasSettings:
     #                                       (n·e > 0 on average; orientation.py); None: the
     #                                       first chart's. Closed surfaces: always outward
 
+    parameter_constraints: ClassVar[dict[str, list]] = {
+        "n_patches": [Interval(int, 1, None), None],
+        # a patch needs enough markers to be embedded
+        "markers_per_patch": [Interval(int, 8, None), None],
+        "gamma_lme": _POSITIVE, "tol_lme": _FRACTION,          # thesis 0.8, 1e-10
+        "chart_hessians": [Options(("exact", "consistent"))],
+        "chart_reproduction": [Options(("linear", "quadratic", "cubic", "quartic"))],
+        "gamma_pu": _POSITIVE, "tol_pu": _FRACTION,            # thesis 4-6, 1e-6
+        "quadrature_order": [Interval(int, 1, None)],          # thesis 6
+        "least_squares_fit": [Types(bool)],
+        "least_squares_scope": [Options(("chart", "global"))],
+        "chart_margin": [*_POSITIVE, None],
+        "graph_neighbors": [Interval(int, 1, None)],
+        "max_stress": _POSITIVE,
+        "max_distortion": [Interval(float, 1, None, closed="neither")],  # a singular-value ratio
+        "max_refinement_depth": [Interval(int, 0, None)],
+        "allow_failed_patches": [Types(bool)],
+        "orientation": [Each(Interval(float)), None],          # non-zero: checked in check()
+    }
+
     @classmethod
     def of(cls, obj) -> "AtlasSettings":
         """The atlas settings held as attributes of ``obj`` (a study whose Config extends or
         equals this class)."""
-        return cls(**{k: getattr(obj, k) for k in cls.__dataclass_fields__})
+        return cls(**{f.name: getattr(obj, f.name) for f in dataclasses.fields(cls)})
 
     def check(self) -> None:
-        for name in ("gamma_lme", "tol_lme", "gamma_pu", "tol_pu", "chart_margin",
-                     "max_stress", "max_distortion"):
-            v = getattr(self, name)
-            if v is None and name == "chart_margin":
-                continue
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-                raise ConfigError(f"{name} = {v!r} is invalid; it must be a finite number > 0.")
-        if self.chart_hessians not in ("exact", "consistent"):
-            raise ConfigError(f"chart_hessians = {self.chart_hessians!r} is invalid; use 'exact' "
-                              "(∂²p_a of the LME basis) or 'consistent' (second-order consistent "
-                              "Hessians, for curvatures on irregular points).")
-        if self.chart_reproduction not in ("linear", "quadratic", "cubic", "quartic"):
-            raise ConfigError(f"chart_reproduction = {self.chart_reproduction!r} is invalid; "
-                              "use 'linear' (LME charts, the thesis) or 'quadratic', 'cubic', "
-                              "'quartic' (the polynomial fit of that degree on the LME support, "
-                              "for curvature on irregular points).")
-        if self.n_patches is not None and self.n_patches < 1:
-            raise ConfigError(f"n_patches = {self.n_patches!r} is invalid; use None or >= 1.")
-        if self.least_squares_scope not in ("chart", "global"):
-            raise ConfigError(f"least_squares_scope = {self.least_squares_scope!r} is invalid; "
-                              "use 'chart' (per-chart interpolation) or 'global' (Paper 2 "
-                              "App. B: one least-squares fit of the blended atlas).")
+        """The declared constraints, and an orientation that is a direction (not zero)."""
+        validate_parameters(self)
         e = self.orientation
-        if e is not None and not (len(e) >= 1 and all(isinstance(v, (int, float))
-                                                       and math.isfinite(v) for v in e)
-                                  and any(v != 0 for v in e)):
-            raise ConfigError(f"orientation = {list(e)!r} is invalid; give a non-zero direction "
+        if e is not None and not (len(e) >= 1 and any(v != 0 for v in e)):
+            raise ConfigError(f"orientation={list(e)!r} is invalid: give a non-zero direction "
                               "[nx, ny, nz], the side the normals of an open surface face "
                               "(e.g. [0, 0, 1]), or leave it unset.")
-        if not isinstance(self.allow_failed_patches, bool):
-            raise ConfigError(f"allow_failed_patches = {self.allow_failed_patches!r} is invalid; "
-                              "use true (keep patches whose charts fail, results flagged) or "
-                              "false (refuse such an atlas, the default).")
-        if self.markers_per_patch is not None and self.markers_per_patch < 8:
-            raise ConfigError(f"markers_per_patch = {self.markers_per_patch!r} is invalid; "
-                              "it must be >= 8 (a patch needs enough markers to be embedded).")
 
     def margin_for(self, d: int) -> float:
         """The chart margin (in units of the median point spacing h) for d-dimensional charts.

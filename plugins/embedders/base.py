@@ -6,14 +6,17 @@ from typing import ClassVar
 
 import numpy as np
 
-from .checks import check_int
+from pointatlas.constraints import validate_parameters
 
 
 class EmbedderBase:
-    """Subclasses define ``Config``, ``description``, ``__init__`` (store only) and ``_embed(X)``.
+    """Subclasses define ``Config`` (with its ``parameter_constraints``), ``description``,
+    ``__init__`` (store only) and ``_embed(X)``; rules that tie settings together go in
+    ``_check_settings``, checks that need the points in ``_embed``.
 
-    ``fit`` validates, embeds (``embedding_raw_``) and, when ``aic`` is true, applies the affine
-    isometric correction (``embedding_``, ``aic_matrix_``, ``stress_raw_``, ``stress_``).
+    ``fit`` validates (:meth:`check_config`), embeds (``embedding_raw_``) and, when ``aic`` is
+    true, applies the affine isometric correction (``embedding_``, ``aic_matrix_``,
+    ``stress_raw_``, ``stress_``).
     """
 
     Config: ClassVar[type]
@@ -31,11 +34,21 @@ class EmbedderBase:
         args = ", ".join(f"{k}={v!r}" for k, v in self.get_params().items())
         return f"{type(self).__name__}({args})"
 
+    def check_config(self) -> None:
+        """The checks that need no data, at start-up and in ``fit``: the constraints the
+        Config declares (:func:`pointatlas.constraints.validate_parameters`), then the rules
+        that tie settings together (:meth:`_check_settings`)."""
+        validate_parameters(self)
+        self._check_settings()
+
+    def _check_settings(self) -> None:
+        """Rules that tie settings together (none here)."""
+
     def _aic_neighbors(self) -> int:
         k = getattr(self, "aic_neighbors", None)
         if k is None:
             k = getattr(self, "n_neighbors", None) or 12
-        return check_int("aic_neighbors", k, low=1, fix="Typical value: 12.")
+        return int(k)
 
     def estimated_bytes(self, n_points: int, ambient_dim: int) -> int:
         """Bytes ``fit`` needs for ``n_points`` points in R^ambient_dim, to refuse a too-large
@@ -50,6 +63,7 @@ class EmbedderBase:
         raise NotImplementedError
 
     def fit(self, X, y=None):
+        self.check_config()
         Y = self._embed(X)
         X = np.asarray(X, float)
         self.embedding_raw_ = Y

@@ -13,7 +13,7 @@ import numpy as np
 from pointatlas.errors import ConfigError
 
 from .base import EmbedderBase
-from .checks import check_graph_params, check_int, check_points
+from .checks import AIC, COMPONENTS, GRAPH, check_graph_fits, check_one_graph, check_points
 from .geodesics import all_geodesic_distances
 from .mds import classical_mds, landmark_mds
 from .neighbor_graph import connected_neighbor_graph
@@ -57,11 +57,13 @@ def landmark_isomap_embedding(X: np.ndarray, n_components: int = 2, n_neighbors:
 
 @dataclass
 class IsomapConfig:
-    n_components: int = 2
-    n_neighbors: Optional[int] = 12
-    radius: Optional[float] = None
+    n_components: int = 2              # below the ambient dimension (checked in fit)
+    n_neighbors: Optional[int] = 12    # k-NN graph, or None when radius is given
+    radius: Optional[float] = None     # radius graph, or None when n_neighbors is given
     aic: bool = False
     aic_neighbors: Optional[int] = None
+
+    parameter_constraints: ClassVar[dict[str, list]] = {**COMPONENTS, **GRAPH, **AIC}
 
 
 class Isomap(EmbedderBase):
@@ -69,11 +71,6 @@ class Isomap(EmbedderBase):
 
     Config: ClassVar[type] = IsomapConfig
     description: ClassVar[str] = "Isomap: classical MDS of shortest-path geodesic distances."
-    parameter_constraints: ClassVar[dict] = {
-        "n_components": "integer, 1 <= n_components < ambient dimension",
-        "n_neighbors": "integer >= 1 (or None when radius is given)",
-        "radius": "float > 0 (or None when n_neighbors is given)",
-    }
 
     def __init__(self, *, n_components: int = 2, n_neighbors: Optional[int] = 12,
                  radius: Optional[float] = None, aic: bool = False,
@@ -89,10 +86,13 @@ class Isomap(EmbedderBase):
         in place by classical MDS), 8 N², plus the graph and the output (EmbedderBase)."""
         return 8 * int(n_points) ** 2 + super().estimated_bytes(n_points, ambient_dim)
 
+    def _check_settings(self) -> None:
+        check_one_graph(self.n_neighbors, self.radius)
+
     def _embed(self, X) -> np.ndarray:
         X = check_points(X, min_points=2)
-        check_graph_params(self.n_neighbors, self.radius, X.shape[0])
-        d = check_int("n_components", self.n_components, low=1)
+        check_graph_fits(self.n_neighbors, X.shape[0])
+        d = int(self.n_components)
         if d >= X.shape[1] or d >= X.shape[0]:
             raise ConfigError(f"n_components={d} must be below the ambient dimension {X.shape[1]} "
                               f"and the number of points {X.shape[0]}; lower n_components.")

@@ -18,22 +18,31 @@ from typing import ClassVar, Optional
 
 import numpy as np
 
+from pointatlas.constraints import Interval, Options
 from pointatlas.errors import ConfigError
 
 from .base import EmbedderBase
-from .checks import check_float, check_int, check_points
+from .checks import AIC, COMPONENTS, check_points
 from .neighbor_graph import connected_neighbor_graph
 
 
 @dataclass
 class LLEConfig:
-    n_components: int = 2
-    n_neighbors: int = 12
-    reg: float = 1e-3
+    n_components: int = 2            # below the ambient dimension (checked in fit)
+    n_neighbors: int = 12            # >= n_components + 1
+    reg: float = 1e-3                # reg * trace(C) added to the local Gram matrix
     eigen_solver: str = "auto"
-    random_state: Optional[int] = 0
+    random_state: Optional[int] = 0  # seed of the arpack start vector (numpy's seed range)
     aic: bool = False
     aic_neighbors: Optional[int] = None
+
+    parameter_constraints: ClassVar[dict[str, list]] = {
+        **COMPONENTS, **AIC,
+        "n_neighbors": [Interval(int, 1, None)],
+        "reg": [Interval(float, 0, None, closed="neither")],
+        "eigen_solver": [Options(("auto", "arpack", "dense"))],
+        "random_state": [Interval(int, 0, 2**32 - 1), None],
+    }
 
 
 class LLEBase(EmbedderBase):
@@ -44,23 +53,22 @@ class LLEBase(EmbedderBase):
     def _min_neighbors(self, d: int) -> int:
         return d + 1
 
-    def _embed(self, X) -> np.ndarray:
-        from sklearn.manifold import LocallyLinearEmbedding
-
-        k = check_int("n_neighbors", self.n_neighbors, low=1, fix="Typical values are 8-30.")
-        X = check_points(X, min_points=k + 1, reason=f" for n_neighbors={k}")
-        d = check_int("n_components", self.n_components, low=1)
-        if d >= X.shape[1]:
-            raise ConfigError(f"n_components={d} must be below the ambient dimension {X.shape[1]}; "
-                              "lower n_components.")
+    def _check_settings(self) -> None:
+        d, k = self.n_components, self.n_neighbors
         if k < self._min_neighbors(d):
             raise ConfigError(
                 f"n_components={d} is too large for n_neighbors={k}: {self._method} LLE needs "
                 f"n_neighbors >= {self._min_neighbors(d)}. Raise n_neighbors or lower n_components."
             )
-        check_float("reg", self.reg, low=0.0, low_open=True, fix="Typical value: 1e-3.")
-        if self.eigen_solver not in ("auto", "arpack", "dense"):
-            raise ConfigError(f"eigen_solver={self.eigen_solver!r}: use 'auto', 'arpack' or 'dense'.")
+
+    def _embed(self, X) -> np.ndarray:
+        from sklearn.manifold import LocallyLinearEmbedding
+
+        k, d = int(self.n_neighbors), int(self.n_components)
+        X = check_points(X, min_points=k + 1, reason=f" for n_neighbors={k}")
+        if d >= X.shape[1]:
+            raise ConfigError(f"n_components={d} must be below the ambient dimension {X.shape[1]}; "
+                              "lower n_components.")
         connected_neighbor_graph(X, k)
         model = LocallyLinearEmbedding(
             n_neighbors=k, n_components=d, reg=self.reg, eigen_solver=self.eigen_solver,

@@ -4,6 +4,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import ClassVar, Optional
 
+from pointatlas.constraints import Interval
+
 from .lle import LLEBase, LLEConfig
 
 
@@ -12,6 +14,11 @@ class MLLEConfig(LLEConfig):
     """LLE's settings plus the tolerance of the modified (multiple-weights) variant."""
 
     modified_tol: float = 1e-12
+
+    parameter_constraints: ClassVar[dict[str, list]] = {
+        **LLEConfig.parameter_constraints,
+        "modified_tol": [Interval(float, 0, None, closed="neither")],
+    }
 
 
 class MLLE(LLEBase):

@@ -23,10 +23,11 @@ from typing import ClassVar, Optional
 
 import numpy as np
 
+from pointatlas.constraints import Interval
 from pointatlas.errors import ConfigError
 
 from .base import EmbedderBase
-from .checks import check_float, check_graph_params, check_int, check_points
+from .checks import AIC, COMPONENTS, GRAPH, check_graph_fits, check_one_graph, check_points
 from .geodesics import geodesic_neighbors, pairs_from_neighbors
 from .isomap import landmark_isomap_embedding
 from .neighbor_graph import connected_neighbor_graph
@@ -149,20 +150,33 @@ def _nlie_optimize(Y0, pi, pj, g, w, alpha, tol, max_iter, lbfgs_tol, lbfgs_max_
 
 @dataclass
 class NLIEConfig:
-    n_components: int = 2
-    n_neighbors: Optional[int] = 12
+    n_components: int = 2             # below the ambient dimension (checked in fit)
+    n_neighbors: Optional[int] = 12   # k-NN graph for geodesic distances (or radius)
     radius: Optional[float] = None
-    n_stress_neighbors: int = 50
-    alpha: float = 0.99
-    tol: float = 1e-6
-    max_iter: int = 50
-    lbfgs_tol: float = 1e-3
-    lbfgs_max_iter: int = 0
-    precond_neighbors: int = 8
-    seed_landmarks: int = 1000
-    random_state: int = 0
+    n_stress_neighbors: int = 50      # k_G < N: neighbours in the stress (thesis 200-1000)
+    alpha: float = 0.99               # weight of E1 (thesis 0.99-0.999 for d > 1, 1 for d = 1)
+    tol: float = 1e-6                 # Newton stop: max_i |dE/dq_i| <= tol kbar / median g
+    max_iter: int = 50                # Newton iterations
+    lbfgs_tol: float = 1e-3           # coarse L-BFGS stop on the relative decrease of E
+    lbfgs_max_iter: int = 0           # L-BFGS iterations before Newton (0: Newton from the seed)
+    precond_neighbors: int = 8        # nearest pairs per point in the Newton-CG preconditioner
+    seed_landmarks: int = 1000        # >= d + 1 landmarks of the Isomap seed (full if >= N)
+    random_state: int = 0             # seed of the landmark choice
     aic: bool = False
     aic_neighbors: Optional[int] = None
+
+    parameter_constraints: ClassVar[dict[str, list]] = {
+        **COMPONENTS, **GRAPH, **AIC,
+        "n_stress_neighbors": [Interval(int, 1, None)],
+        "alpha": [Interval(float, 0, 1, closed="right")],
+        "tol": [Interval(float, 0, None, closed="neither")],
+        "max_iter": [Interval(int, 0, None)],
+        "lbfgs_tol": [Interval(float, 0, None, closed="neither")],
+        "lbfgs_max_iter": [Interval(int, 0, None)],
+        "precond_neighbors": [Interval(int, 1, None)],
+        "seed_landmarks": [Interval(int, 2, None)],
+        "random_state": [Interval(int, 0, None)],
+    }
 
 
 class NLIE(EmbedderBase):
@@ -170,16 +184,6 @@ class NLIE(EmbedderBase):
 
     Config: ClassVar[type] = NLIEConfig
     description: ClassVar[str] = "NLIE: sparse geodesic stress minimisation seeded by Isomap."
-    parameter_constraints: ClassVar[dict] = {
-        "n_neighbors": "integer >= 1: k-NN graph for geodesic distances (or radius)",
-        "n_stress_neighbors": "integer k_G >= 1, < N: neighbours in the stress (thesis 200-1000)",
-        "alpha": "float in (0, 1]: weight of E1 (thesis 0.99-0.999 for d > 1, 1 for d = 1)",
-        "tol": "float > 0: Newton stop, max_i |dE/dq_i| <= tol * kbar / median geodesic distance",
-        "lbfgs_tol": "float > 0: coarse L-BFGS stop on the relative decrease of E per iteration",
-        "lbfgs_max_iter": "integer >= 0: L-BFGS iterations before Newton (0: Newton from the seed)",
-        "precond_neighbors": "integer >= 1: nearest pairs per point in the Newton-CG preconditioner",
-        "seed_landmarks": "integer >= d + 1: landmarks of the Isomap seed (full Isomap if >= N)",
-    }
 
     def __init__(self, *, n_components: int = 2, n_neighbors: Optional[int] = 12,
                  radius: Optional[float] = None, n_stress_neighbors: int = 50,
@@ -202,23 +206,28 @@ class NLIE(EmbedderBase):
         self.aic = aic
         self.aic_neighbors = aic_neighbors
 
+    def _check_settings(self) -> None:
+        check_one_graph(self.n_neighbors, self.radius)
+        if self.seed_landmarks < self.n_components + 1:
+            raise ConfigError(
+                f"seed_landmarks={self.seed_landmarks!r} is invalid: it must be >= n_components "
+                f"+ 1 = {self.n_components + 1} (landmark MDS in dimension d). Pass e.g. "
+                "seed_landmarks=1000.")
+
     def _embed(self, X) -> np.ndarray:
         X = check_points(X, min_points=2)
         n = X.shape[0]
-        check_graph_params(self.n_neighbors, self.radius, n)
-        d = check_int("n_components", self.n_components, low=1)
+        check_graph_fits(self.n_neighbors, n)
+        d = int(self.n_components)
         if d >= X.shape[1]:
             raise ConfigError(f"n_components={d} must be below the ambient dimension {X.shape[1]}.")
-        kG = check_int("n_stress_neighbors", self.n_stress_neighbors, low=1, high=n - 1,
-                       fix=f"With {n} points use at most {n - 1}; the thesis uses 200-1000.")
-        alpha = check_float("alpha", self.alpha, low=0.0, high=1.0, low_open=True,
-                            fix="Use 0.99-0.999 for d > 1 and 1 for d = 1.")
-        check_float("tol", self.tol, low=0.0, low_open=True)
-        check_float("lbfgs_tol", self.lbfgs_tol, low=0.0, low_open=True)
-        check_int("max_iter", self.max_iter, low=0)
-        check_int("lbfgs_max_iter", self.lbfgs_max_iter, low=0)
-        k_pre = check_int("precond_neighbors", self.precond_neighbors, low=1)
-        n_land = check_int("seed_landmarks", self.seed_landmarks, low=d + 1)
+        kG = int(self.n_stress_neighbors)
+        if kG > n - 1:
+            raise ConfigError(
+                f"n_stress_neighbors={kG} is invalid for {n} points: it must be <= {n - 1}. "
+                "Lower it; the thesis uses 200-1000 on larger sets.")
+        alpha, k_pre = float(self.alpha), int(self.precond_neighbors)
+        n_land = int(self.seed_landmarks)
         G = connected_neighbor_graph(X, self.n_neighbors, self.radius)
         idx, dist = geodesic_neighbors(G, kG)
         pi, pj, g, w = pairs_from_neighbors(idx, dist)

@@ -9,14 +9,16 @@ import numpy as np
 from pointatlas.errors import ConfigError
 
 from .base import EmbedderBase
-from .checks import check_int, check_points
+from .checks import AIC, COMPONENTS, check_points
 
 
 @dataclass
 class PCAConfig:
-    n_components: int = 2
-    aic: bool = False
-    aic_neighbors: Optional[int] = 12
+    n_components: int = 2            # below the ambient dimension D (checked in fit)
+    aic: bool = False                # apply the affine isometric correction
+    aic_neighbors: Optional[int] = 12  # neighbours in the AIC stress
+
+    parameter_constraints: ClassVar[dict[str, list]] = {**COMPONENTS, **AIC}
 
 
 class PCA(EmbedderBase):
@@ -24,11 +26,6 @@ class PCA(EmbedderBase):
 
     Config: ClassVar[type] = PCAConfig
     description: ClassVar[str] = "Principal component analysis: linear projection on d leading directions."
-    parameter_constraints: ClassVar[dict] = {
-        "n_components": "integer, 1 <= n_components < ambient dimension D",
-        "aic": "bool: apply the affine isometric correction",
-        "aic_neighbors": "integer >= 1, neighbours in the AIC stress",
-    }
 
     def __init__(self, *, n_components: int = 2, aic: bool = False,
                  aic_neighbors: Optional[int] = 12):
@@ -40,7 +37,7 @@ class PCA(EmbedderBase):
         from sklearn.decomposition import PCA as _PCA
 
         X = check_points(X, min_points=2)
-        d = check_int("n_components", self.n_components, low=1)
+        d = int(self.n_components)
         if d >= X.shape[1]:
             raise ConfigError(
                 f"n_components={d} but the points live in R^{X.shape[1]}: PCA needs "

@@ -8,8 +8,8 @@ import numpy as np
 
 from pointatlas.stores_config import stores_config
 
-from .parametric_curve import CURVE_CONSTRAINTS, ParametricCurve
-from .surface_source import require_positive
+from .parametric_curve import ParametricCurve
+from .surface_source import COMMON_CONSTRAINTS, POSITIVE
 
 
 @stores_config
@@ -27,14 +27,12 @@ class Circle(ParametricCurve):
         radius: float = 1.0
         n_markers: Optional[int] = None
 
+        parameter_constraints: ClassVar[dict[str, list]] = {**COMMON_CONSTRAINTS,
+                                                            "radius": POSITIVE}
+
     description: ClassVar[str] = "Circle of given radius in the plane (a closed curve, d = 1)."
-    parameter_constraints: ClassVar[dict[str, str]] = {
-        **CURVE_CONSTRAINTS, "radius": "finite number > 0"}
     name: ClassVar[str] = "circle"
     closed: ClassVar[bool] = True
-
-    def _check(self) -> None:
-        require_positive("radius", self.radius)
 
     def _span(self):
         return 0.0, 2.0 * np.pi

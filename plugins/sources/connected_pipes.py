@@ -38,7 +38,7 @@ from typing import ClassVar, Optional
 import numpy as np
 
 from .level_set import near_level_set, project_to_level_set
-from .surface_source import COMMON_CONSTRAINTS, SurfaceSource, require, require_positive
+from .surface_source import COMMON_CONSTRAINTS, POSITIVE, SurfaceSource, require
 
 #: Candidates per output point for the structured (farthest-point) selection.
 OVERSAMPLING = 6
@@ -157,14 +157,15 @@ class ConnectedPipes(SurfaceSource):
         scale: float = 1.0
         n_markers: Optional[int] = None
 
+        # core_level m: level of q = G^{1/4} at the tube's core, with half_width w
+        # 0 < m − w < 1 < m + w (genus 2; checked with both); w: half-width of the tube in q;
+        # height ζ: the vertical half-thickness of the tube is ζ·w; scale: length unit
+        # (lateral extent ≈ 2·sqrt(1+(m+w)²)·scale)
+        parameter_constraints: ClassVar[dict[str, list]] = {
+            **COMMON_CONSTRAINTS, "core_level": POSITIVE, "half_width": POSITIVE,
+            "height": POSITIVE, "scale": POSITIVE}
+
     description: ClassVar[str] = "Closed genus-2 tube around a figure-eight (connected pipes)."
-    parameter_constraints: ClassVar[dict[str, str]] = {
-        **COMMON_CONSTRAINTS,
-        "core_level": "m: level of q = G^{1/4} at the tube's core; with half_width w, "
-                      "0 < m − w < 1 < m + w (genus 2)",
-        "half_width": "w > 0: half-width of the tube in q",
-        "height": "ζ > 0: vertical half-thickness of the tube is ζ·w",
-        "scale": "finite number > 0: length unit (lateral extent ≈ 2·sqrt(1+(m+w)²)·scale)"}
     name: ClassVar[str] = "connected_pipes"
 
     def __init__(self, *, n_points: int = 2000, sampling: str = "structured",
@@ -182,14 +183,11 @@ class ConnectedPipes(SurfaceSource):
         return float(self.core_level), float(self.half_width), float(self.height)
 
     def _check(self) -> None:
-        for name in ("core_level", "half_width", "height"):
-            require_positive(name, getattr(self, name))
         m, w, _ = self._params()
         require(0.0 < m - w < 1.0 < m + w, "core_level", self.core_level,
                 f"with half_width={w} must satisfy 0 < core_level − half_width < 1 < "
                 "core_level + half_width (else the holes close or the tube splits: genus ≠ 2)",
                 "Use e.g. core_level=1.2, half_width=0.45.")
-        require_positive("scale", self.scale)
 
     def implicit_function(self, X: np.ndarray) -> np.ndarray:
         """F at points given in output (scaled) coordinates."""

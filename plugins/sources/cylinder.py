@@ -17,7 +17,9 @@ import numpy as np
 from pointatlas.stores_config import stores_config
 
 from .shell_source import SHELL_CONSTRAINTS, ShellSource, intervals, jitter, rectangle_grid
-from .surface_source import require_positive
+from pointatlas.constraints import Options
+
+from .surface_source import POSITIVE
 
 
 @stores_config
@@ -41,17 +43,14 @@ class Cylinder(ShellSource):
         model: str = "full"
         n_markers: Optional[int] = None
 
+        # model 'quarter': x, y >= 0; 'eighth': x, y, z >= 0
+        parameter_constraints: ClassVar[dict[str, list]] = {
+            **SHELL_CONSTRAINTS, "radius": POSITIVE, "length": POSITIVE,
+            "model": [Options(("full", "quarter", "eighth"))]}
+
     description: ClassVar[str] = "Open cylinder of the pinched-cylinder benchmark (full/quarter/eighth)."
-    parameter_constraints: ClassVar[dict[str, str]] = {
-        **SHELL_CONSTRAINTS, "radius": "finite number > 0", "length": "finite number > 0",
-        "model": "'full', 'quarter' (x, y >= 0) or 'eighth' (x, y, z >= 0)"}
-    models: ClassVar[tuple[str, ...]] = ("full", "quarter", "eighth")
     name: ClassVar[str] = "cylinder"
 
-
-    def _check(self) -> None:
-        require_positive("radius", self.radius)
-        require_positive("length", self.length)
 
     def _ranges(self):
         L = float(self.length)

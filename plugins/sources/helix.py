@@ -8,8 +8,8 @@ import numpy as np
 
 from pointatlas.stores_config import stores_config
 
-from .parametric_curve import CURVE_CONSTRAINTS, ParametricCurve
-from .surface_source import require_positive
+from .parametric_curve import ParametricCurve
+from .surface_source import COMMON_CONSTRAINTS, POSITIVE
 
 
 @stores_config
@@ -31,16 +31,13 @@ class Helix(ParametricCurve):
         turns: float = 2.0
         n_markers: Optional[int] = None
 
+        # pitch: rise per turn
+        parameter_constraints: ClassVar[dict[str, list]] = {
+            **COMMON_CONSTRAINTS, "radius": POSITIVE, "pitch": POSITIVE, "turns": POSITIVE}
+
     description: ClassVar[str] = "Circular helix in R^3 (an open curve, d = 1)."
-    parameter_constraints: ClassVar[dict[str, str]] = {
-        **CURVE_CONSTRAINTS, "radius": "finite number > 0",
-        "pitch": "finite number > 0: rise per turn", "turns": "finite number > 0"}
     name: ClassVar[str] = "helix"
     closed: ClassVar[bool] = False
-
-    def _check(self) -> None:
-        for name in ("radius", "pitch", "turns"):
-            require_positive(name, getattr(self, name))
 
     def _span(self):
         return 0.0, 2.0 * np.pi * float(self.turns)

@@ -15,7 +15,9 @@ import numpy as np
 from pointatlas.stores_config import stores_config
 
 from .shell_source import JITTER, SHELL_CONSTRAINTS, ShellSource, intervals
-from .surface_source import require, require_positive
+from pointatlas.constraints import Interval
+
+from .surface_source import POSITIVE
 
 
 @stores_config
@@ -42,21 +44,15 @@ class Hemisphere(ShellSource):
         model: str = "full"
         n_markers: Optional[int] = None
 
+        # hole_angle_deg: polar angle of the hole at the pole (0: closed, 18: classical open
+        # hemisphere); model 'quarter': x >= 0, y >= 0
+        parameter_constraints: ClassVar[dict[str, list]] = {
+            **SHELL_CONSTRAINTS, "radius": POSITIVE,
+            "hole_angle_deg": [Interval(float, 0, 90, closed="left")]}
+
     description: ClassVar[str] = "Hemisphere of radius 10 (closed, or with a polar hole), full or quarter."
-    parameter_constraints: ClassVar[dict[str, str]] = {
-        **SHELL_CONSTRAINTS, "radius": "finite number > 0",
-        "hole_angle_deg": "number in [0, 90): polar angle of the hole at the pole, degrees "
-        "(0 = closed, 18 = classical open hemisphere)",
-        "model": "'full' or 'quarter' (x >= 0, y >= 0)"}
     name: ClassVar[str] = "hemisphere"
 
-
-    def _check(self) -> None:
-        require_positive("radius", self.radius)
-        a = self.hole_angle_deg
-        require(isinstance(a, (int, float)) and not isinstance(a, bool) and 0.0 <= a < 90.0,
-                "hole_angle_deg", a, "must be in [0, 90) degrees",
-                "Use hole_angle_deg=0 (closed at the pole) or 18 (classical open hemisphere).")
 
     def _span(self) -> float:
         return 2 * np.pi if self.model == "full" else np.pi / 2

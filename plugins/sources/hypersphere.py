@@ -7,10 +7,11 @@ from typing import ClassVar, Optional
 
 import numpy as np
 
+from pointatlas.constraints import Interval
 from pointatlas.stores_config import stores_config
 
 from .lattices import fibonacci_band
-from .surface_source import COMMON_CONSTRAINTS, SurfaceSource, require, require_positive
+from .surface_source import COMMON_CONSTRAINTS, POSITIVE, SurfaceSource, require
 
 #: ψ⁴ = ψ + 4: the second irrational of the super-Fibonacci spiral on S^3 (Alexa, CVPR 2022)
 SUPER_FIBONACCI_PSI = 1.533751168755204288118041
@@ -68,11 +69,11 @@ class Hypersphere(SurfaceSource):
         dim: int = 3
         n_markers: Optional[int] = None
 
+        # dim: intrinsic dimension n (ambient R^(n+1)); structured sampling needs n <= 3
+        parameter_constraints: ClassVar[dict[str, list]] = {
+            **COMMON_CONSTRAINTS, "radius": POSITIVE, "dim": [Interval(int, 1, None)]}
+
     description: ClassVar[str] = "Round n-sphere S^n in R^(n+1) (default S^3 in R^4, d = 3)."
-    parameter_constraints: ClassVar[dict[str, str]] = {
-        **COMMON_CONSTRAINTS, "radius": "finite number > 0",
-        "dim": "integer >= 1: intrinsic dimension n (ambient R^(n+1)); structured "
-               "sampling needs n <= 3"}
     name: ClassVar[str] = "hypersphere"
 
     @property
@@ -80,10 +81,7 @@ class Hypersphere(SurfaceSource):
         return int(self.dim)
 
     def _check(self) -> None:
-        require_positive("radius", self.radius)
         d = self.dim
-        require(isinstance(d, (int, np.integer)) and not isinstance(d, bool) and d >= 1,
-                "dim", d, "must be an integer >= 1", "Use dim=3 for S^3 in R^4.")
         require(self.sampling == "random" or d <= 3, "dim", d,
                 "structured sampling exists for dim <= 3",
                 "Use sampling='random' for higher-dimensional spheres.")

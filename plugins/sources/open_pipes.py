@@ -43,8 +43,8 @@ from pointatlas.stores_config import stores_config
 
 from .farthest_point import farthest_point_order
 from .level_set import near_level_set, project_to_level_set
-from .shell_source import JITTER, SHELL_CONSTRAINTS
-from .surface_source import SurfaceSource, check_rng, require, require_positive
+from .shell_source import JITTER
+from .surface_source import COMMON_CONSTRAINTS, POSITIVE, SurfaceSource, check_rng, require
 
 #: Candidates per output point for the farthest-point selection (6 left candidate holes that
 #: the boundary detection occasionally took for edges, random sampling at 2500 points).
@@ -190,15 +190,17 @@ class OpenPipes(SurfaceSource):
         blend: float = 0.45
         n_markers: Optional[int] = None
 
+        # each > 0; the rules that tie them together are checked in _check: n_points gives at
+        # least 8 points per end circle (2πr/h >= 8); pipe_radius r of all pipes; half_width
+        # a >= 2r + k (vertical pipes' axes x = ±a, lateral size 2(a+r)); half_height
+        # H >= b + r + k + r/4 (the pipes end at z = ±H, plain cylinders there); rung_offset
+        # b >= 2(r + k) (rungs at z = −b, 0, b, junction blends kept apart); blend k <= r
+        # (smoothing radius of the junction fillets)
+        parameter_constraints: ClassVar[dict[str, list]] = {
+            **COMMON_CONSTRAINTS, "pipe_radius": POSITIVE, "half_width": POSITIVE,
+            "half_height": POSITIVE, "rung_offset": POSITIVE, "blend": POSITIVE}
+
     description: ClassVar[str] = "Ladder of connected pipes (genus 2) with four open ends."
-    parameter_constraints: ClassVar[dict[str, str]] = {
-        **SHELL_CONSTRAINTS,
-        "n_points": "integer >= 4 with at least 8 points per end circle (2πr/h >= 8)",
-        "pipe_radius": "r > 0: radius of all pipes",
-        "half_width": "a >= 2r + k: the vertical pipes' axes are x = ±a (lateral size 2(a+r))",
-        "half_height": "H >= b + r + k + r/4: the pipes end at z = ±H (plain cylinders there)",
-        "rung_offset": "b >= 2(r + k): rungs at z = −b, 0, b (junction blends kept apart)",
-        "blend": "k in (0, r]: smoothing radius of the junction fillets"}
     name: ClassVar[str] = "open_pipes"
 
     def _geometry(self):
@@ -206,8 +208,6 @@ class OpenPipes(SurfaceSource):
                 float(self.blend))
 
     def _check(self) -> None:
-        for name in ("pipe_radius", "half_width", "half_height", "rung_offset", "blend"):
-            require_positive(name, getattr(self, name))
         r, a, b, k = self._geometry()
         H = float(self.half_height)
         require(k <= r, "blend", self.blend, f"must be in (0, pipe_radius={r}]",

@@ -20,13 +20,6 @@ import numpy as np
 
 from .surface_source import SurfaceSource
 
-CURVE_CONSTRAINTS = {
-    "n_points": "integer >= 4: number of points sampling the curve",
-    "sampling": "'structured' (equally spaced in arc length) or 'random' (uniform in arc "
-    "length; an open curve keeps its two end points)",
-    "n_markers": "None, or an integer in [4, n_points): size of a coarser marker set",
-}
-
 #: parameter samples of the arc-length table and of the exact integrals
 TABLE_SIZE = 8192
 
@@ -42,7 +35,6 @@ def squared_curvature(v: np.ndarray, acc: np.ndarray) -> np.ndarray:
 class ParametricCurve(SurfaceSource):
     """Base of the analytic curves; not a plugin by itself."""
 
-    parameter_constraints: ClassVar[dict[str, str]] = CURVE_CONSTRAINTS
     intrinsic_dim: ClassVar[int] = 1
     closed: ClassVar[bool] = True
 

@@ -13,7 +13,7 @@ import numpy as np
 from pointatlas.stores_config import stores_config
 
 from .shell_source import SHELL_CONSTRAINTS, ShellSource, intervals, jitter, rectangle_grid
-from .surface_source import require_positive
+from .surface_source import POSITIVE
 
 
 @stores_config
@@ -34,15 +34,13 @@ class SquarePlate(ShellSource):
         model: str = "full"
         n_markers: Optional[int] = None
 
+        # length: side of the full plate; model 'full' ([-L/2, L/2]^2) or 'quarter' ([0, L/2]^2)
+        parameter_constraints: ClassVar[dict[str, list]] = {**SHELL_CONSTRAINTS,
+                                                            "length": POSITIVE}
+
     description: ClassVar[str] = "Square plate of the pinched-plate benchmark (full or quarter)."
-    parameter_constraints: ClassVar[dict[str, str]] = {
-        **SHELL_CONSTRAINTS, "length": "finite number > 0: side of the full plate",
-        "model": "'full' ([-L/2, L/2]^2) or 'quarter' ([0, L/2]^2)"}
     name: ClassVar[str] = "square_plate"
 
-
-    def _check(self) -> None:
-        require_positive("length", self.length)
 
     def _side_range(self):
         L = float(self.length)

@@ -10,6 +10,7 @@ from typing import ClassVar, Optional
 import numpy as np
 
 from pointatlas.config import NOT_FROM_EXPERIMENTS
+from pointatlas.constraints import Interval, Options, Types, validate_parameters
 from pointatlas.errors import ConfigError, InputError
 from pointatlas.pointcloud import PointCloud, validate_points
 
@@ -166,14 +167,17 @@ class PointFile:
         #: 'random' (a seeded random subset)
         subsample: str = "farthest"
 
+        # path: an existing, readable file with a suffix in SUFFIXES (checked in
+        # check_config); intrinsic_dim: at most the ambient dimension (checked in load);
+        # name None: the file stem
+        parameter_constraints: ClassVar[dict[str, list]] = {
+            "intrinsic_dim": [Interval(int, 1, None), None],
+            "name": [Types(str), None],
+            "n_points": [Interval(int, 1, None), None],
+            "subsample": [Options(("farthest", "random"))],
+        }
+
     description: ClassVar[str] = "Point set read from a file (.npz, .ply, .vtk/.vtp, .csv/.txt)."
-    parameter_constraints: ClassVar[dict[str, str]] = {
-        "path": f"existing file with suffix in {SUFFIXES}",
-        "intrinsic_dim": "None or an integer in [1, ambient dimension]",
-        "name": "None (use the file stem) or a label",
-        "n_points": "None or an integer >= 1 (at most this many points are kept)",
-        "subsample": "'farthest' (quasi-uniform subset, for accurate curvatures) or 'random'",
-    }
 
     def __init__(self, *, path: str = "???", intrinsic_dim: Optional[int] = None,
                  name: Optional[str] = None, n_points: Optional[int] = None,
@@ -186,7 +190,8 @@ class PointFile:
 
     def check_config(self) -> Path:
         """The checks that need no reading (run at start-up): the path names a readable,
-        non-empty file of a known format; ``subsample`` and ``n_points`` are valid."""
+        non-empty file of a known format; the declared parameter constraints hold."""
+        validate_parameters(self)
         if not isinstance(self.path, (str, Path)) or str(self.path) in ("", "???"):
             raise ConfigError("path is missing: the 'file' source needs path=<file with points>, "
                               "e.g. source.path=data/points.npz on the command line.")
@@ -197,13 +202,6 @@ class PointFile:
                              f"{', '.join(SUFFIXES)}; convert the file, e.g. save "
                              "numpy.savez(name + '.npz', points=X).")
         check_readable_file(path)
-        if self.subsample not in ("farthest", "random"):
-            raise ConfigError(f"subsample={self.subsample!r} is invalid: use 'farthest' "
-                              "(quasi-uniform subset) or 'random' (seeded random subset).")
-        n = self.n_points
-        if n is not None and (not isinstance(n, (int, np.integer)) or isinstance(n, bool)
-                              or n < 1):
-            raise ConfigError(f"n_points={n!r} is invalid: must be None or an integer >= 1.")
         return path
 
     def load(self, rng: np.random.Generator | None = None) -> PointCloud:
@@ -233,7 +231,7 @@ class PointFile:
         if markers is not None:
             markers = validate_points(markers, what=f"markers of {path}")
         d = self.intrinsic_dim
-        if d is not None and not (isinstance(d, (int, np.integer)) and 1 <= d <= points.shape[1]):
+        if d is not None and d > points.shape[1]:
             raise ConfigError(f"intrinsic_dim={d!r} is invalid: must be None or an integer in "
                               f"[1, {points.shape[1]}] (the ambient dimension of {path}).")
         n, total = self.n_points, len(points)

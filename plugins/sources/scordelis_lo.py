@@ -15,7 +15,9 @@ import numpy as np
 from pointatlas.stores_config import stores_config
 
 from .shell_source import SHELL_CONSTRAINTS, ShellSource, intervals, jitter, rectangle_grid
-from .surface_source import require, require_positive
+from pointatlas.constraints import Interval
+
+from .surface_source import POSITIVE
 
 
 @stores_config
@@ -38,21 +40,14 @@ class ScordelisLoRoof(ShellSource):
         model: str = "full"
         n_markers: Optional[int] = None
 
+        # model 'quarter': theta >= 0, y >= 0
+        parameter_constraints: ClassVar[dict[str, list]] = {
+            **SHELL_CONSTRAINTS, "radius": POSITIVE, "length": POSITIVE,
+            "half_angle_deg": [Interval(float, 0, 90, closed="right")]}  # half opening angle
+
     description: ClassVar[str] = "Scordelis-Lo cylindrical roof (R=25, L=50, 40 deg), full or quarter."
-    parameter_constraints: ClassVar[dict[str, str]] = {
-        **SHELL_CONSTRAINTS, "radius": "finite number > 0", "length": "finite number > 0",
-        "half_angle_deg": "number in (0, 90]: half opening angle of the roof, degrees",
-        "model": "'full' or 'quarter' (theta >= 0, y >= 0)"}
     name: ClassVar[str] = "scordelis_lo_roof"
 
-
-    def _check(self) -> None:
-        require_positive("radius", self.radius)
-        require_positive("length", self.length)
-        a = self.half_angle_deg
-        require(isinstance(a, (int, float)) and not isinstance(a, bool) and 0.0 < a <= 90.0,
-                "half_angle_deg", a, "must be in (0, 90] degrees",
-                "Use half_angle_deg=40 for the Scordelis-Lo roof.")
 
     def _ranges(self):
         T, L = np.deg2rad(float(self.half_angle_deg)), float(self.length)

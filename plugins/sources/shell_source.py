@@ -15,25 +15,20 @@ is as near n_points as the grid allows, typically within a few per cent).
 """
 from __future__ import annotations
 
-from typing import ClassVar
-
 import numpy as np
 
+from pointatlas.constraints import Options
 from pointatlas.pointcloud import PointCloud, check_distinct
 
-from .surface_source import COMMON_CONSTRAINTS, SurfaceSource, check_rng, require
+from .surface_source import COMMON_CONSTRAINTS, SurfaceSource, check_rng
 
 #: Maximal jitter of the 'random' samplings, as a fraction of the local grid spacing.
 JITTER = 0.3
 
-SHELL_CONSTRAINTS = {
-    **COMMON_CONSTRAINTS,
-    "n_points": "integer >= 4: target number of points (grids round it to whole rows)",
-    "sampling": "'structured' (grid with grid lines on all edges) or 'random' (the same grid "
-    "jittered: quasi-uniform and unstructured, boundary points stay on their edges)",
-    "n_markers": "None (markers one refinement level coarser, about n_points/4) or an integer "
-    "in [4, n_points): target size of the marker set",
-}
+#: the common settings (n_points and n_markers are targets here: grids round them to whole
+#: rows; n_markers None: one refinement level coarser, about n_points/4) and the model, the
+#: full surface or a symmetric part
+SHELL_CONSTRAINTS = {**COMMON_CONSTRAINTS, "model": [Options(("full", "quarter"))]}
 
 
 def intervals(length: float, h: float, minimum: int = 1, multiple: int = 1) -> int:
@@ -82,8 +77,6 @@ class ShellSource(SurfaceSource):
     (``rng`` is None for 'structured', a Generator for 'random') and ``_exact()``.
     """
 
-    parameter_constraints: ClassVar[dict[str, str]] = SHELL_CONSTRAINTS
-    models: ClassVar[tuple[str, ...]] = ("full", "quarter")
     model: str
 
     def _area(self) -> float:  # pragma: no cover - overridden
@@ -91,10 +84,6 @@ class ShellSource(SurfaceSource):
 
     def _grid(self, h: float, rng):  # pragma: no cover - overridden
         raise NotImplementedError
-
-    def _check_model(self) -> None:
-        require(self.model in self.models, "model", self.model, f"must be one of {self.models}",
-                f"Use model='{self.models[0]}' or one of {self.models[1:]} for a symmetric part.")
 
     def spacing(self, n: int) -> float:
         """Grid spacing h giving about n points (length units).
@@ -116,7 +105,6 @@ class ShellSource(SurfaceSource):
         """Sample the surface and its markers; all randomness comes from ``rng``."""
         check_rng(rng)
         self._check_common()
-        self._check_model()
         self._check()
         random = self.sampling == "random"
         h = self.spacing(int(self.n_points))

@@ -7,7 +7,7 @@ from typing import ClassVar, Optional
 import numpy as np
 
 from .lattices import fibonacci_band
-from .surface_source import COMMON_CONSTRAINTS, SurfaceSource, require_positive
+from .surface_source import COMMON_CONSTRAINTS, POSITIVE, SurfaceSource
 
 
 def spherical_to_cartesian(radius: float, z_unit: np.ndarray, phi: np.ndarray) -> np.ndarray:
@@ -37,9 +37,10 @@ class Sphere(SurfaceSource):
         radius: float = 1.0
         n_markers: Optional[int] = None
 
+        parameter_constraints: ClassVar[dict[str, list]] = {**COMMON_CONSTRAINTS,
+                                                            "radius": POSITIVE}
+
     description: ClassVar[str] = "Round sphere of given radius (Fibonacci lattice or uniform random)."
-    parameter_constraints: ClassVar[dict[str, str]] = {
-        **COMMON_CONSTRAINTS, "radius": "finite number > 0"}
     name: ClassVar[str] = "sphere"
 
     def __init__(self, *, n_points: int = 1000, sampling: str = "structured",
@@ -48,9 +49,6 @@ class Sphere(SurfaceSource):
         self.sampling = sampling
         self.radius = radius
         self.n_markers = n_markers
-
-    def _check(self) -> None:
-        require_positive("radius", self.radius)
 
     def _sample(self, n, sampling, rng):
         if sampling == "structured":

@@ -1,7 +1,10 @@
 """Shared machinery of the analytic surface generators: validation, markers, PointCloud.
 
-A subclass implements ``_check()`` (geometry validation), ``_sample(n, sampling, rng)``
-returning ``(points (n, 3), parameters (n, 2))`` and ``_exact()`` (known exact quantities).
+A subclass's ``Config`` declares its parameter constraints (:data:`COMMON_CONSTRAINTS` plus its
+own, checked by :func:`pointatlas.constraints.validate_parameters` at start-up and in
+``load``). A subclass implements ``_check()`` (the rules that tie settings together),
+``_sample(n, sampling, rng)`` returning ``(points (n, 3), parameters (n, 2))`` and
+``_exact()`` (known exact quantities).
 Markers (thesis §3.3) are a second, coarser sampling of the same surface with
 ``n_markers`` points, drawn with the same sampling scheme.
 """
@@ -11,16 +14,21 @@ from typing import ClassVar
 
 import numpy as np
 
+from pointatlas.constraints import Interval, Options, validate_parameters
 from pointatlas.errors import ConfigError
 from pointatlas.pointcloud import PointCloud
 
 SAMPLINGS = ("structured", "random")
 
+#: a finite length > 0 (a radius, a side, a scale)
+POSITIVE = [Interval(float, 0, None, closed="neither")]
+
+#: the settings every generator has: the number of points, the sampling scheme (see each
+#: class) and the size of a coarser marker set (None, or below n_points: checked with it)
 COMMON_CONSTRAINTS = {
-    "n_points": "integer >= 4: number of points sampling the surface",
-    "sampling": "'structured' (deterministic quasi-uniform lattice) or 'random' "
-    "(independent, uniform with respect to surface area)",
-    "n_markers": "None, or an integer in [4, n_points): size of a coarser marker set",
+    "n_points": [Interval(int, 4, None)],
+    "sampling": [Options(SAMPLINGS)],
+    "n_markers": [Interval(int, 4, None), None],
 }
 
 
@@ -28,14 +36,6 @@ def require(ok: bool, name: str, value, valid: str, fix: str) -> None:
     """Raise :class:`ConfigError` naming the value, the valid range and the fix."""
     if not ok:
         raise ConfigError(f"{name}={value!r} is invalid: {valid}. {fix}")
-
-
-def require_positive(name: str, value) -> None:
-    require(
-        isinstance(value, (int, float)) and not isinstance(value, bool) and np.isfinite(value)
-        and value > 0,
-        name, value, "must be a finite number > 0", f"Set {name} to a positive length.",
-    )
 
 
 def check_rng(rng) -> None:
@@ -48,7 +48,6 @@ def check_rng(rng) -> None:
 class SurfaceSource:
     """Base of the analytic surfaces; not a plugin by itself."""
 
-    parameter_constraints: ClassVar[dict[str, str]] = COMMON_CONSTRAINTS
     name: ClassVar[str] = "surface"
     intrinsic_dim: ClassVar[int] = 2
 
@@ -69,30 +68,18 @@ class SurfaceSource:
 
     # -- shared ---------------------------------------------------------------------
     def _check_common(self) -> None:
-        n = self.n_points
+        """The declared constraints of the Config, and n_markers below n_points."""
+        validate_parameters(self)
+        n, m = self.n_points, self.n_markers
         require(
-            isinstance(n, (int, np.integer)) and not isinstance(n, bool) and n >= 4,
-            "n_points", n, "must be an integer >= 4", "Pass e.g. n_points=1000.",
+            m is None or m < n, "n_markers", m, f"must be None or an integer in [4, n_points={n})",
+            "Markers are a coarser set; a common choice is n_markers ≈ n_points/4 "
+            "(one refinement level coarser).",
         )
-        require(
-            self.sampling in SAMPLINGS, "sampling", self.sampling,
-            f"must be one of {SAMPLINGS}", "Use sampling='structured' or sampling='random'.",
-        )
-        m = self.n_markers
-        if m is not None:
-            require(
-                isinstance(m, (int, np.integer)) and not isinstance(m, bool) and 4 <= m < n,
-                "n_markers", m, f"must be None or an integer in [4, n_points={n})",
-                "Markers are a coarser set; a common choice is n_markers ≈ n_points/4 "
-                "(one refinement level coarser).",
-            )
 
     def check_config(self) -> None:
         """The checks that need no sampling (run at start-up, before any work)."""
         self._check_common()
-        check_model = getattr(self, "_check_model", None)
-        if callable(check_model):
-            check_model()
         self._check()
 
     def load(self, rng: np.random.Generator) -> PointCloud:

@@ -11,8 +11,10 @@ from typing import ClassVar, Optional
 
 import numpy as np
 
+from pointatlas.constraints import Interval
+
 from .lattices import allocate_counts, rows_for_rectangle, staggered_rows
-from .surface_source import COMMON_CONSTRAINTS, SurfaceSource, require
+from .surface_source import COMMON_CONSTRAINTS, POSITIVE, SurfaceSource
 
 T_MIN, T_MAX = 1.5 * np.pi, 4.5 * np.pi
 
@@ -52,10 +54,11 @@ class SwissRoll(SurfaceSource):
         noise: float = 0.0
         n_markers: Optional[int] = None
 
+        # height: extent along y; noise: standard deviation of the Gaussian noise
+        parameter_constraints: ClassVar[dict[str, list]] = {
+            **COMMON_CONSTRAINTS, "height": POSITIVE, "noise": [Interval(float, 0, None)]}
+
     description: ClassVar[str] = "Classical swiss roll, t in [1.5π, 4.5π] (thesis Fig. 2)."
-    parameter_constraints: ClassVar[dict[str, str]] = {
-        **COMMON_CONSTRAINTS, "height": "finite number > 0 (extent along y)",
-        "noise": "finite number >= 0 (std of Gaussian noise)"}
     name: ClassVar[str] = "swiss_roll"
 
     def __init__(self, *, n_points: int = 1000, sampling: str = "random",
@@ -65,14 +68,6 @@ class SwissRoll(SurfaceSource):
         self.height = height
         self.noise = noise
         self.n_markers = n_markers
-
-    def _check(self) -> None:
-        ok = isinstance(self.height, (int, float)) and np.isfinite(self.height)
-        require(ok and self.height > 0, "height", self.height, "must be a finite number > 0",
-                "Use e.g. height=21.0 (the classical value).")
-        ok = isinstance(self.noise, (int, float)) and np.isfinite(self.noise)
-        require(ok and self.noise >= 0, "noise", self.noise, "must be a finite number >= 0",
-                "Use noise=0.0 for points exactly on the surface.")
 
     @property
     def length(self) -> float:

@@ -11,7 +11,7 @@ from typing import ClassVar, Optional
 import numpy as np
 
 from .lattices import allocate_counts, staggered_rows
-from .surface_source import COMMON_CONSTRAINTS, SurfaceSource, require, require_positive
+from .surface_source import COMMON_CONSTRAINTS, POSITIVE, SurfaceSource, require
 
 
 def torus_points(R: float, r: float, u: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -69,10 +69,11 @@ class Torus(SurfaceSource):
         r: float = 0.5
         n_markers: Optional[int] = None
 
+        # R: major radius, r: tube radius, r < R (checked with both)
+        parameter_constraints: ClassVar[dict[str, list]] = {**COMMON_CONSTRAINTS,
+                                                            "R": POSITIVE, "r": POSITIVE}
+
     description: ClassVar[str] = "Ring torus of radii R > r (area-aware lattice or uniform random)."
-    parameter_constraints: ClassVar[dict[str, str]] = {
-        **COMMON_CONSTRAINTS, "R": "finite number > r (major radius)",
-        "r": "finite number in (0, R) (tube radius)"}
     name: ClassVar[str] = "torus"
 
     def __init__(self, *, n_points: int = 1000, sampling: str = "structured",
@@ -84,8 +85,6 @@ class Torus(SurfaceSource):
         self.n_markers = n_markers
 
     def _check(self) -> None:
-        require_positive("R", self.R)
-        require_positive("r", self.r)
         require(self.r < self.R, "r", self.r, f"must be smaller than R={self.R} (ring torus)",
                 "Choose r < R, e.g. R=1.0, r=0.5.")
 

@@ -8,8 +8,8 @@ import numpy as np
 
 from pointatlas.stores_config import stores_config
 
-from .parametric_curve import CURVE_CONSTRAINTS, ParametricCurve
-from .surface_source import require_positive
+from .parametric_curve import ParametricCurve
+from .surface_source import COMMON_CONSTRAINTS, POSITIVE
 
 
 @stores_config
@@ -28,14 +28,13 @@ class TrefoilKnot(ParametricCurve):
         scale: float = 1.0
         n_markers: Optional[int] = None
 
+        # scale: length unit of the knot
+        parameter_constraints: ClassVar[dict[str, list]] = {**COMMON_CONSTRAINTS,
+                                                            "scale": POSITIVE}
+
     description: ClassVar[str] = "Trefoil knot in R^3 (a closed curve of varying curvature, d = 1)."
-    parameter_constraints: ClassVar[dict[str, str]] = {
-        **CURVE_CONSTRAINTS, "scale": "finite number > 0: length unit of the knot"}
     name: ClassVar[str] = "trefoil"
     closed: ClassVar[bool] = True
-
-    def _check(self) -> None:
-        require_positive("scale", self.scale)
 
     def _span(self):
         return 0.0, 2.0 * np.pi

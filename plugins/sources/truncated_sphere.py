@@ -31,9 +31,11 @@ from typing import ClassVar, Optional
 
 import numpy as np
 
+from pointatlas.constraints import Interval
+
 from .lattices import allocate_counts, fibonacci_band, staggered_rows
 from .sphere import sphere_parameters, spherical_to_cartesian
-from .surface_source import COMMON_CONSTRAINTS, SurfaceSource, require, require_positive
+from .surface_source import COMMON_CONSTRAINTS, POSITIVE, SurfaceSource
 
 
 def spherical_rows(n: int, cut: float, phi_span: float):
@@ -70,10 +72,12 @@ class TruncatedSphere(SurfaceSource):
         cut: float = 0.5
         n_markers: Optional[int] = None
 
+        # cut: the cap z > cut·radius is removed
+        parameter_constraints: ClassVar[dict[str, list]] = {
+            **COMMON_CONSTRAINTS, "radius": POSITIVE,
+            "cut": [Interval(float, -1, 1, closed="neither")]}
+
     description: ClassVar[str] = "Sphere with the polar cap z > cut·R removed (thesis Fig. 5)."
-    parameter_constraints: ClassVar[dict[str, str]] = {
-        **COMMON_CONSTRAINTS, "radius": "finite number > 0",
-        "cut": "number in (-1, 1): the cap z > cut·radius is removed"}
     name: ClassVar[str] = "truncated_sphere"
     phi_span: ClassVar[float] = 2.0 * np.pi
 
@@ -84,15 +88,6 @@ class TruncatedSphere(SurfaceSource):
         self.radius = radius
         self.cut = cut
         self.n_markers = n_markers
-
-    def _check(self) -> None:
-        require_positive("radius", self.radius)
-        require(
-            isinstance(self.cut, (int, float)) and not isinstance(self.cut, bool)
-            and -1.0 < self.cut < 1.0,
-            "cut", self.cut, "must be in (-1, 1) (fraction of the radius)",
-            "Use e.g. cut=0.5 to remove the cap above z = R/2.",
-        )
 
     def _structured(self, n):
         return fibonacci_band(n, -1.0, float(self.cut), self.phi_span)

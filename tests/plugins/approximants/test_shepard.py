@@ -1,4 +1,6 @@
 """Gaussian Shepard partition of unity: sums, derivatives, analytic values, errors."""
+import dataclasses
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -81,5 +83,5 @@ def test_errors_and_registry():
     with pytest.raises(ConfigError, match="gamma"):
         Shepard(gamma=0).fit(np.random.default_rng(0).random((10, 2)))
     assert pointatlas.load_plugin("approximants", "shepard") is Shepard
-    assert set(Shepard.Config.__dataclass_fields__) == {
+    assert {f.name for f in dataclasses.fields(Shepard.Config)} == {
         "gamma", "tol", "n_spacing_neighbors", "outside"}

@@ -89,7 +89,7 @@ def test_rows_too_small_for_a_quadratic_fit_keep_their_hessians():
 
 
 def test_bad_hessians_option_names_the_choices():
-    with pytest.raises(ConfigError, match="hessians = 'smooth'.*'exact'.*'consistent'"):
+    with pytest.raises(ConfigError, match="hessians='smooth' is invalid.*'exact'.*'consistent'"):
         LocalMaxEnt(hessians="smooth").fit(np.random.default_rng(0).random((20, 2)))
 
 
@@ -193,5 +193,5 @@ def test_quartic_fit_gives_the_curvature_of_a_randomly_sampled_sphere():
 
 
 def test_bad_reproduction_option_names_the_choices():
-    with pytest.raises(ConfigError, match="reproduction = 'quintic'.*'linear'.*'quartic'"):
+    with pytest.raises(ConfigError, match="reproduction='quintic' is invalid.*'linear'.*'quartic'"):
         LocalMaxEnt(reproduction="quintic").fit(np.random.default_rng(0).random((20, 2)))

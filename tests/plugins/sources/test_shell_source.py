@@ -19,7 +19,7 @@ def test_plugin_convention(name):
     assert {k: p.default for k, p in params.items()} == fields
     assert all(p.kind is p.KEYWORD_ONLY for p in params.values())
     assert isinstance(cls.description, str) and "\n" not in cls.description
-    assert set(fields) <= set(cls.parameter_constraints)
+    assert set(fields) <= set(cls.Config.parameter_constraints)  # every setting declared
     pytest.importorskip("omegaconf").OmegaConf.structured(cls.Config)
     obj = cls(**fields)
     assert all(getattr(obj, k) == v for k, v in fields.items())  # __init__ only stores

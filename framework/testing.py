@@ -43,36 +43,59 @@ def check_contract(cls: type) -> None:
         assert hasattr(obj, key) and _same(getattr(obj, key), value), (
             f"{name}.__init__ must store {key!r} unchanged (scikit-learn convention)")
     _check_hydra(config, name)
+    check_parameter_constraints(cls, defaults)
     check_refuses_bad_values(cls, defaults)
+
+
+def check_parameter_constraints(cls: type, defaults: dict | None = None) -> None:
+    """The ``parameter_constraints`` of ``cls.Config`` are well formed (lists of
+    :mod:`pointatlas.constraints` objects, keyed by Config fields) and its defaults meet them."""
+    from .constraints import declared_constraints, describe, meets
+    from .errors import PluginError
+
+    name = cls.__name__
+    try:
+        declared = declared_constraints(cls)
+    except PluginError as exc:
+        raise AssertionError(str(exc)) from exc
+    for key, allowed in declared.items():
+        if defaults is not None and key in defaults:
+            assert meets(defaults[key], allowed), (
+                f"{name}.Config default {key}={defaults[key]!r} does not meet its own declared "
+                f"constraint ({describe(allowed)})")
 
 
 def check_refuses_bad_values(cls: type, defaults: dict) -> None:
     """A bad value is refused with :class:`pointatlas.ConfigError` or ``ValueError``.
 
-    For each float setting, the plugin is built with NaN there; its ``__init__`` and its
-    ``check_config()`` (the start-up check the run pipeline calls before any work, see
-    :mod:`pointatlas.config_check`) may raise only ``ValueError`` (ConfigError is one), and a
-    plugin that has ``check_config`` must refuse the NaN: no parameter of a plugin is
-    meaningful as NaN.
+    For each float setting, the plugin is built with NaN there and given the start-up check
+    (:func:`pointatlas.config_check.check_plugin_settings`: its declared parameter
+    constraints, then its ``check_config()``); they may raise only ``ValueError``
+    (ConfigError is one), and a plugin that declares a constraint on that setting or has a
+    ``check_config`` must refuse the NaN: no parameter of a plugin is meaningful as NaN.
     """
+    from .config_check import check_plugin_settings
+    from .constraints import declared_constraints
+
     name = cls.__name__
+    declared = declared_constraints(cls)
     for key, value in defaults.items():
         if isinstance(value, bool) or not isinstance(value, float):
             continue
         try:
-            plugin = cls(**{**defaults, key: float("nan")})
-            check = getattr(plugin, "check_config", None)
-            if callable(check):
-                check()
+            check_plugin_settings(cls(**{**defaults, key: float("nan")}))
         except ValueError:
             continue
         except Exception as exc:  # noqa: BLE001 - the wrong kind of refusal is the failure
             raise AssertionError(
                 f"{name} with {key}=nan raised {type(exc).__name__} ({exc}); refuse bad values "
                 "with pointatlas.ConfigError (or ValueError) naming the key and the fix") from exc
+        assert key not in declared, (
+            f"{name} accepts {key}=nan although its Config declares a constraint on {key}")
         assert not callable(getattr(cls, "check_config", None)), (
-            f"{name}.check_config() accepts {key}=nan; check that {key} is a finite number in "
-            "its valid range and raise pointatlas.ConfigError naming it and the fix")
+            f"{name}.check_config() accepts {key}=nan; declare {key}'s valid range in "
+            "Config.parameter_constraints (pointatlas.constraints.Interval) or check it, and "
+            "raise pointatlas.ConfigError naming it and the fix")
 
 
 def _same(a, b) -> bool:
@@ -154,8 +177,22 @@ def check_approximant(cls: type, *, dim: int = 2, reproduces_linear: bool = Fals
 
 
 def check_physics(cls: type, **kwargs: Any) -> None:
+    """The plugin contract, ``solve``, declared ``fields`` and, for a physics written on the
+    kit (``discrete_energy``), its residual and tangent against finite differences of its
+    energy on a small curved patch, a symmetric tangent and rigid-motion invariance where
+    claimed (:mod:`pointatlas.physics_conformance`). ``kwargs``: Config values to use."""
     check_contract(cls)
-    assert callable(getattr(cls, "solve", None)), f"{cls.__name__} must define solve(ctx, ...)"
+    name = cls.__name__
+    assert callable(getattr(cls, "solve", None)), f"{name} must define solve(ctx, ...)"
+    if not callable(getattr(cls, "discrete_energy", None)):
+        return
+    fields = getattr(cls, "fields", ())
+    assert fields and all(hasattr(f, "name") and hasattr(f, "components") and
+                          hasattr(f, "order") for f in fields), (
+        f"{name}.fields must declare the fields of its energies (kit Field objects)")
+    from .physics_conformance import check_discrete_energy
+
+    check_discrete_energy(cls(**kwargs))
 
 
 def check_study(cls: type, **kwargs: Any) -> None:

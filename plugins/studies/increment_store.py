@@ -3,7 +3,7 @@
 After every converged increment the shell path study rewrites ``increments.nc`` in its run
 directory with all increments so far (:func:`write_increments`): the path Dataset plus the
 nodal displacements, and the path follower's state after each increment
-(:class:`pointatlas_physics.kirchhoff_love.path_state.PathState`, variables ``path_state_*``),
+(:class:`pointatlas_solvers.path_state.PathState`, variables ``path_state_*``),
 so that ``study.resume_from`` continues the path exactly (:func:`read_increments`). The file
 is written under a temporary name in the same directory (``.increments.nc.<random>.tmp``),
 flushed to disk, renamed over ``increments.nc`` and the directory is flushed too: a kill at
@@ -143,8 +143,8 @@ def read_increments(run_dir, settings: dict):
 
 def _records(old) -> list:
     """The Increments (with their PathState) of an increments Dataset."""
-    from pointatlas_physics.kirchhoff_love.incremental import Increment
-    from pointatlas_physics.kirchhoff_love.path_state import PathState
+    from pointatlas_solvers.increment import Increment
+    from pointatlas_solvers.path_state import PathState
 
     def row(name, k, default=np.nan):
         return old[name].values[k] if name in old else default

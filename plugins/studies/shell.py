@@ -79,19 +79,17 @@ class ShellStudy:
         physics = ctx.plugin("physics")
         with ctx.timed("analysis"):
             ds = physics.solve(ctx, cloud=cloud, atlas_settings=atlas_settings)
-        model = physics.model_
-        out = self._results(ctx, ds, model, cloud)
+        out = self._results(ctx, ds, physics, cloud)
         if ds.attrs.get("warnings"):
             out.attrs["warnings"] = ds.attrs["warnings"]
         return out
 
-    def _results(self, ctx, ds, model, cloud):
-        from pointatlas_physics.kirchhoff_love.analysis import displacement_at
-        from pointatlas_physics.kirchhoff_love.results import write_vtp
-
+    def _results(self, ctx, ds, physics, cloud):
+        """Reference displacement, errors and the .vtp, through the physics protocol."""
         e = np.asarray(self.reference_direction, dtype=np.float64)
         e = e / np.linalg.norm(e)
-        u, x = displacement_at(model, self.reference_point)
+        u, x = physics.evaluate("displacement", np.reshape(self.reference_point, (1, 3)))
+        u, x = u[0], x[0]
         value = float(u @ e)
         ds["displacement"] = ((), value, {
             "long_name": f"displacement at the reference point along {np.round(e, 6).tolist()}",
@@ -113,27 +111,24 @@ class ShellStudy:
                                         "units": "1"})
             ctx.log.info("displacement %.8g; relative error %s", value, ", ".join(
                 f"{lab}: {abs(value - r) / abs(r):.3e}" for lab, r in zip(labels, refs)))
-        size = float(np.ptp(model.points, axis=0).max())
+        size = float(np.ptp(ds["position"].values, axis=0).max())
         umax = float(ds["max_displacement"])
         mag = self.magnification or (0.1 * size / umax if umax > 0 else 1.0)
         ds.attrs["magnification"] = mag
-        # the side the normals (and pressures) of the atlas face: 'outward', the user's
-        # atlas.orientation '[nx, ny, nz]', 'first_chart' (not fixed) or 'none' (non-orientable)
-        ds.attrs["normal_orientation"] = str(model.atlas.orientation_)
         ds.attrs["title"] = f"Kirchhoff–Love shell: {cloud.name}, {int(ds['dof'])} DOF"
         if self.write_vtp:
-            write_vtp(model, ctx.run_dir / "shell.vtp", mag)
+            physics.export_vtp(ctx.run_dir / "shell.vtp", mag)
         return ds
 
     @staticmethod
     def report_figures(ds):
-        from pointatlas_physics.kirchhoff_love.results import deformed_picture
+        from .shell_figures import deformed_picture
 
         return [("Deformed shape (displacement magnified "
                  f"{float(ds.attrs.get('magnification', 1.0)):.3g}×)", deformed_picture(ds))]
 
     @staticmethod
     def report_sweep_figures(ds):
-        from pointatlas_physics.kirchhoff_love.convergence import convergence_figures
+        from .shell_convergence import convergence_figures
 
         return convergence_figures(ds)

@@ -1,19 +1,19 @@
 """Geometrically nonlinear shell analysis along a load path (thesis §4.4, Paper 2 §4–5).
 
 The ``kirchhoff_love`` plugin builds the atlas, loads and supports; this study follows the
-load path (:mod:`pointatlas_physics.kirchhoff_love.incremental`) under ``control``:
+load path (:mod:`pointatlas_solvers.path_following`) under ``control``:
 
 - ``force``: the loads grow with λ (uniform steps, cut on failure);
 - ``displacement``: the ``displacement`` supports' imposed values grow with λ, there are no
   loads, and ``load`` is the reaction of those supports along their imposed direction;
-- ``arc_length``: Crisfield's arc length (:mod:`pointatlas_physics.kirchhoff_love.arc_length`)
+- ``arc_length``: Crisfield's arc length (:mod:`pointatlas_solvers.arc_length`)
   on loads and imposed displacements together, through limit points and snap-backs; with
   ``branch_switching`` it also leaves the path at simple bifurcations for the secondary
-  branch (eigenvector injection, :mod:`pointatlas_physics.kirchhoff_love.branch_switching`);
+  branch (eigenvector injection, :mod:`pointatlas_solvers.branch_switching`);
 - under ``force`` or ``displacement`` control with ``stable_path``, every increment is solved
   by descent on the energy, so it ends on a stable state: past a limit point or a
   bifurcation, the one the shell snaps to (``snapped``;
-  :mod:`pointatlas_physics.kirchhoff_love.stable_equilibrium`);
+  :mod:`pointatlas_solvers.stable_equilibrium`);
 
 and records, along a dim ``increment``: ``load_factor``, ``load`` (= load_factor × ``full_load``
 under loads),
@@ -50,7 +50,7 @@ class ShellPathSettings(ShellStudySettings):
     control: str = "force"              # force | displacement | arc_length
     lbfgs_iterations: int = 0           # L-BFGS iterations before Newton in each increment
     lbfgs_tol: float = 1.0e-2           # ... until |∇Π| ≤ lbfgs_tol·|load|
-    line_search: bool = False           # Armijo backtracking in Newton (see incremental)
+    line_search: bool = False           # Armijo backtracking in Newton (see increment)
     max_increments: int = 400           # arc length: increments before giving up
     branch_switching: bool = False      # arc length: leave the path at simple bifurcations
     max_branch_switches: int = 3        # ... at most this many times
@@ -124,10 +124,8 @@ class ShellNonlinearStudy:
         return P, E / np.linalg.norm(E, axis=1)[:, None], names
 
     def run(self, ctx):
-        from pointatlas_physics.kirchhoff_love.analysis import (assemble_loads,
-                                                                 assemble_supports,
-                                                                 build_model)
-        from pointatlas_physics.kirchhoff_love.incremental import PathSettings, follow_path
+        from pointatlas_solvers.increment import PathSettings
+        from pointatlas_solvers.path_following import follow_path
 
         from pointatlas.errors import ConfigError
 
@@ -147,20 +145,16 @@ class ShellNonlinearStudy:
         with ctx.timed("source"):
             cloud = ctx.plugin("source").load(ctx.rng("source"))
         physics = ctx.plugin("physics")
-        s = physics.shell_settings()
         with ctx.timed("model"):
-            model = build_model(cloud, s, atlas_settings, **physics.factories(ctx, atlas_settings),
-                                log=ctx.log)
-            F = assemble_loads(model, s, ctx.log)
-            cons = assemble_supports(model, s)
-        start = self._resume(history, model, cons) if history else None
+            model = physics.path_problem(ctx, cloud=cloud, atlas_settings=atlas_settings)
+        start = self._resume(history, model) if history else None
         records = list(history)
-        probe = monitor_operator(model, P, E)   # projections once, not per increment
-        fields = point_fields(model)             # u and energy density at the sampled points
+        probe = model.probe(P, E)        # projections once, not per increment
+        fields = model.point_fields()    # u and energy density at the sampled points
         values = [probe(r.U) for r in records]
         self._fields = [fields(r.U) for r in records]
         self._points = model.points
-        self._check_control(F, s)
+        self._check_control(model)
         path = PathSettings(self.n_increments, self.max_load_factor, self.max_newton,
                             self.newton_tol, control="arc_length" if self.control ==
                             "arc_length" else "load", lbfgs_iterations=self.lbfgs_iterations,
@@ -170,9 +164,8 @@ class ShellNonlinearStudy:
                             max_branch_switches=self.max_branch_switches,
                             stable_path=self.stable_path,
                             levels=tuple(self.reference_load_factors))
-        self._imposed = [(k, np.asarray(sup.value, float)) for k, sup in enumerate(s.supports)
-                         if sup.kind == "displacement"]
-        self._has_loads = bool(np.any(F))
+        self._imposed = model.imposed
+        self._has_loads = model.has_loads
 
         def keep(inc):
             records.append(inc)
@@ -183,23 +176,23 @@ class ShellNonlinearStudy:
                          ", ".join(f"{n} = {v:.5g}" for n, v in zip(names, values[-1])))
             self._write(ctx.run_dir / "increments.nc", model, records, values, names, settings)
 
-        from pointatlas_physics.kirchhoff_love.incremental import PathFollowingError
+        from pointatlas_solvers.increment import PathFollowingError
 
         stopped = ""
         with ctx.timed("path"):
             try:
-                follow_path(model, s, path, F, cons, keep, ctx.log, start=start)
+                follow_path(model.problem, path, keep, ctx.log, start=start)
             except PathFollowingError as exc:
                 stopped = str(exc)
                 ctx.log.error("%s", exc)
         ds = self._dataset(model, records, values, names)
         ds.attrs["stopped"] = stopped or "completed the load path"
-        warning = model.atlas.refinement_warning()  # failed patches, kept by the user's choice
+        warning = model.warning()  # failed patches, kept by the user's choice
         if warning:
             ds.attrs["warnings"] = warning
         return ds
 
-    def _check_control(self, F, s) -> None:
+    def _check_control(self, model) -> None:
         """The control is known and has something to apply (loads or imposed values)."""
         from pointatlas.errors import ConfigError
 
@@ -214,16 +207,16 @@ class ShellNonlinearStudy:
             raise ConfigError("study.stable_path=true needs study.control=force or displacement "
                               "(arc length follows the unstable branches on purpose; use "
                               "branch_switching there).")
-        imposed = any(sup.kind == "displacement" for sup in s.supports)
+        imposed = bool(model.imposed)
         if self.control == "displacement":
             if not imposed:
                 raise ConfigError("study.control=displacement needs a support of kind "
                                   "'displacement' (its value grows with the load factor).")
-            if np.any(F):
+            if model.has_loads:
                 raise ConfigError("study.control=displacement applies no loads, but "
                                   "physics.loads is not empty: remove the loads, or use "
                                   "study.control=force or arc_length to scale both.")
-        elif not np.any(F) and not imposed:
+        elif not model.has_loads and not imposed:
             raise ConfigError(f"study.control={self.control} but there is nothing to apply: "
                               "give physics.loads or a 'displacement' support.")
 
@@ -239,20 +232,20 @@ class ShellNonlinearStudy:
         return total, ("reaction force of the imposed-displacement supports along their "
                        "imposed direction")
 
-    def _resume(self, history, model, cons):
+    def _resume(self, history, model):
         """Where the path goes on from the increments of ``resume_from``, after checking that
         they fit this model (same settings give the same model; this guards the file)."""
-        from pointatlas_physics.kirchhoff_love.path_state import PathStart
+        from pointatlas_solvers.path_state import PathStart
 
         from pointatlas.errors import InputError
 
         state = history[-1].state
-        if (history[-1].U.shape != model.nodes.shape or state.U.size != model.nodes.size
-                or state.mu.size != cons.matrix.shape[0]):
+        if (history[-1].U.size != model.n_dofs or state.U.size != model.n_dofs
+                or state.mu.size != model.n_constraint_rows):
             raise InputError(f"study.resume_from={self.resume_from}: its increments hold "
-                             f"{history[-1].U.shape[0]} nodes and {state.mu.size} support rows "
-                             f"but this model has {model.nodes.shape[0]} and "
-                             f"{cons.matrix.shape[0]}: resume with the same source and "
+                             f"{history[-1].U.size} DOF and {state.mu.size} support rows "
+                             f"but this model has {model.n_dofs} and "
+                             f"{model.n_constraint_rows}: resume with the same source and "
                              "settings, or rerun without study.resume_from.")
         return PathStart(history, state)
 
@@ -260,7 +253,7 @@ class ShellNonlinearStudy:
         from .shell_path_results import path_dataset
 
         pairs = [self._load(r.load_factor, r.reactions) for r in records]
-        return path_dataset(self, model.dof, self._points, records, values, names,
+        return path_dataset(self, model.n_dofs, self._points, records, values, names,
                             self._fields, pairs)
 
     def _write(self, path: Path, model, records, values, names, settings):
@@ -275,25 +268,3 @@ class ShellNonlinearStudy:
 
         return path_figures(ds)
 
-
-def point_fields(model):
-    """U -> (u(x_a) (n, 3), energy density (n, 3): membrane, bending, total) at the sampled
-    points; the bases are computed once."""
-    from pointatlas_atlas.evaluation import basis_at_nodes
-    from pointatlas_physics.kirchhoff_love.snapshots import point_energy_operator
-
-    basis, _, _ = basis_at_nodes(model.atlas, np.arange(model.points.shape[0]), order=0)
-    B = basis.to_csr(model.nodes.shape[0])
-    energy_at = point_energy_operator(model)
-    return lambda U: (B @ np.asarray(U).reshape(-1, 3), energy_at(U))
-
-
-def monitor_operator(model, P: np.ndarray, E: np.ndarray):
-    """U -> (u(p_i)·e_i)_i at the surface points nearest to P: the closest-point projections
-    and the basis there are computed once (Paper 2 App. A), then each call is one product."""
-    from pointatlas_atlas.evaluation import basis_at
-    from pointatlas_atlas.projection import closest_point
-
-    proj = closest_point(model.atlas, np.asarray(P, dtype=np.float64).reshape(-1, 3))
-    B = basis_at(model.atlas, proj.chart, proj.xi, order=0).to_csr(model.nodes.shape[0])
-    return lambda U: np.einsum("ij,ij->i", B @ np.asarray(U).reshape(-1, 3), E)

@@ -169,7 +169,7 @@ def path_figures(ds):
         title += ")"
     figures = [(title, fig)]
     if "energy_density" in ds and ds.sizes["increment"]:
-        from pointatlas_physics.kirchhoff_love.snapshots import pick_snapshots, snapshot_figure
+        from .shell_figures import pick_snapshots, snapshot_figure
 
         picks = pick_snapshots(ds.sizes["increment"], 4)
         figures.append((

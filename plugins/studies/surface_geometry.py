@@ -31,22 +31,9 @@ class SurfaceGeometry:
         "energy and total Gaussian curvature vs exact values."
     )
 
-    #: the atlas parameters (n_patches, markers_per_patch, gamma_lme, ...): AtlasSettings
+    #: the atlas parameters (n_patches, markers_per_patch, gamma_lme, ...): AtlasSettings,
+    #: with their declared constraints (AtlasSettings.parameter_constraints)
     Config = AtlasSettings
-
-    parameter_constraints: ClassVar[dict[str, str]] = {
-        "n_patches": "None or int >= 1",
-        "markers_per_patch": "int >= 8",
-        "gamma_lme": "float > 0 (thesis 0.8)", "tol_lme": "float in (0, 1) (thesis 1e-10)",
-        "gamma_pu": "float > 0 (thesis 4–6)", "tol_pu": "float in (0, 1) (thesis 1e-6)",
-        "chart_hessians": "'exact' (thesis) or 'consistent' (irregular points)",
-        "chart_reproduction": "'linear' (thesis); 'quadratic', 'cubic', 'quartic' (irregular "
-                              "points)",
-        "quadrature_order": "int >= 1 (thesis 6)",
-        "chart_margin": "None (3 for d <= 2, 5 for d = 3) or float > 0",
-        "max_stress": "float > 0", "max_distortion": "float > 1",
-    }
-
 
     def settings(self, ctx=None) -> AtlasSettings:
         """The run's ``atlas.*`` settings (the old ``study.*`` spellings still honoured, with a
@@ -72,15 +59,10 @@ class SurfaceGeometry:
                 "(sphere, torus, connected_pipes) or a file of 3-D points on a surface.")
         s = self.settings(ctx)
         check_order(s.quadrature_order)
-        atlas = Atlas(
-            s,
-            make_embedder=lambda: ctx.plugin("embedder"),
-            make_lme=lambda: ctx.make("approximants", "lme", gamma=s.gamma_lme, tol=s.tol_lme,
-                                      outside="flag", hessians=s.chart_hessians,
-                                      reproduction=s.chart_reproduction),
-            make_pu=lambda: ctx.make("approximants", "shepard", gamma=s.gamma_pu, tol=s.tol_pu,
-                                     outside="flag"),
-        )
+        from pointatlas_kit.surface_model import atlas_factories
+
+        atlas = Atlas(s, **atlas_factories(ctx, s, hessians=s.chart_hessians,
+                                           reproduction=s.chart_reproduction))
         with ctx.timed("partition"):
             atlas.partition(cloud.points, cloud.markers)
         ctx.log.info("%d markers -> %d METIS patches -> %d after recursive refinement",

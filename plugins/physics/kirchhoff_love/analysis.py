@@ -14,7 +14,6 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from pointatlas.errors import InputError
 
@@ -29,7 +28,7 @@ class ShellModel:
     curves: list
     spacing: float
     atlas: object
-    quadrature: object            # ShellQuadrature over all charts
+    quadrature: object            # pointatlas_kit AtlasQuadrature over all charts
     material: object
     stiffness: object = None
     forces: np.ndarray | None = None          # (N + G, 3)
@@ -57,74 +56,27 @@ def _timed(times: dict, key: str):
 
 def build_model(cloud, settings, atlas_settings, make_embedder, make_lme, make_pu,
                 log=None) -> ShellModel:
-    """Boundary, ghosts, atlas and quadrature of a shell point cloud (no physics yet)."""
-    from pointatlas_atlas.atlas import Atlas
-    from pointatlas_atlas.boundary import boundary_curves, boundary_mask
-    from pointatlas_atlas.ghosts import ghost_points
+    """Boundary, ghosts, atlas and quadrature of a shell point cloud (no physics yet), by
+    the kit (:func:`pointatlas_kit.surface_model.build_surface_model`, order-2 basis)."""
+    from pointatlas_kit.surface_model import build_surface_model
 
     from .material import ShellMaterial
-    from .quadrature_data import concatenate, from_basis
 
     material = ShellMaterial(young_modulus=settings.young_modulus,
                              poisson_ratio=settings.poisson_ratio, thickness=settings.thickness)
     material.check()
-    times: dict = {}
-    P = cloud.points
-    if P.shape[1] != 3:
-        raise InputError(f"a shell needs points in R^3; {cloud.name} has D = {P.shape[1]}.")
-    spacing = float(np.median(cKDTree(P).query(P, k=2)[0][:, 1]))
-    with _timed(times, "boundary"):
-        boundary = boundary_mask(P)
-        curves = boundary_curves(P, boundary) if boundary.any() else []
-        G = (ghost_points(P, boundary, layers=settings.ghost_layers)
-             if boundary.any() and settings.ghost_layers > 0 else np.zeros((0, 3)))
-    nodes = np.vstack([P, G])
-    real = np.arange(nodes.shape[0]) < P.shape[0]
-    markers = cloud.markers if cloud.markers is not None else P
-    atlas = Atlas(atlas_settings, make_embedder, make_lme, make_pu)
-    with _timed(times, "partition"):
-        atlas.partition(nodes, markers, keep_basis=True)  # AtlasError: charts fail after repair
-    warning = atlas.refinement_warning()  # only with atlas.allow_failed_patches=true
-    if warning and log is not None:
-        log.warning(warning)
-    with _timed(times, "charts"):
-        atlas.build_charts()
-    with _timed(times, "quadrature"):
-        atlas.build_quadrature(real=real, keep_basis=True)
-        parts = []
-        for k, cq in enumerate(atlas.quadrature_):
-            if len(cq.weights) == 0:
-                continue
-            parts.append(from_basis(cq.basis, cq.tangents, cq.second, cq.weights,
-                                    np.full(len(cq.weights), k), nodes.shape[0]))
-        quadrature = concatenate(parts)
-    _check_support(atlas, quadrature, nodes.shape[0], real)
-    if log is not None:
-        log.info("%d points (%d on the boundary, %d curves) + %d ghosts; %d patches, "
-                 "%d quadrature points", P.shape[0], int(boundary.sum()), len(curves),
-                 G.shape[0], len(atlas.charts_), len(quadrature.weights))
-    return ShellModel(P, nodes, boundary, curves, spacing, atlas, quadrature, material,
-                      times=times)
-
-
-def _check_support(atlas, q, n_nodes: int, real: np.ndarray) -> None:
-    """Every real node must carry some quadrature (else the cloud is too sparse)."""
-    touched = np.zeros(n_nodes, bool)
-    touched[q.indices] = True
-    lonely = np.flatnonzero(real & ~touched)
-    if lonely.size:
-        raise InputError(
-            f"{lonely.size} point(s) (first: {lonely[:5].tolist()}) lie in no chart's "
-            "quadrature: the point cloud is too sparse or irregular there for the chart support. "
-            "Sample the surface more densely or lower study.markers_per_patch.")
+    m = build_surface_model(cloud, atlas_settings, make_embedder, make_lme, make_pu, order=2,
+                            ghost_layers=settings.ghost_layers, log=log)
+    return ShellModel(m.points, m.nodes, m.boundary, m.curves, m.spacing, m.atlas,
+                      m.quadrature, material, times=m.times)
 
 
 def solve_linear(model: ShellModel, settings, log=None) -> ShellModel:
     """Stiffness, loads, supports and the augmented-Lagrangian solve; fills ``model``."""
     from pointatlas_atlas.evaluation import basis_at_nodes
+    from pointatlas_solvers.augmented_lagrangian import solve_augmented
 
     from .linear import linear_stiffness
-    from .solver import solve_augmented
 
     t = model.times
     N_all = model.nodes.shape[0]
@@ -136,7 +88,7 @@ def solve_linear(model: ShellModel, settings, log=None) -> ShellModel:
         cons = assemble_supports(model, settings)
     with _timed(t, "solve"):
         U, _, info = solve_augmented(K, F.ravel(), cons.matrix, cons.rhs, settings.penalty,
-                                     settings.constraint_tol, method=settings.solver)
+                                     settings.constraint_tol, backend=settings.solver)
     U = U.reshape(-1, 3)
     with _timed(t, "post"):
         basis, _, _ = basis_at_nodes(model.atlas, np.arange(model.points.shape[0]), order=0)
@@ -187,18 +139,11 @@ def assemble_supports(model: ShellModel, settings):
 
 
 def ghost_springs(K, model: ShellModel, eps: float = 1e-10) -> np.ndarray:
-    """(3(N+G),) spring stiffness per DOF: ε·mean(diag K) on ghost DOFs and mean(diag K) on
-    DOFs no quadrature point sees. A ghost node far out carries basis functions that are ~0
-    on the sampled surface (cut off by the LME tolerance), so its DOFs are (nearly) free:
-    the spring pins them at 0 without changing the displacement of the surface noticeably."""
-    n = model.nodes.shape[0]
-    scale = float(K.diagonal().mean())
-    node_w = np.zeros(n)
-    node_w[model.points.shape[0]:] = eps
-    seen = np.zeros(n, bool)
-    seen[model.quadrature.indices] = True
-    node_w[~seen] = 1.0
-    return np.repeat(node_w * scale, 3)
+    """(3(N+G),) weak springs on ghost DOFs (:func:`pointatlas_kit.surface_model.
+    ghost_springs` with the diagonal of K)."""
+    from pointatlas_kit.surface_model import ghost_springs as springs
+
+    return springs(K.diagonal(), model, 3, eps)
 
 
 def regularize_ghosts(K, model: ShellModel, eps: float = 1e-10):
@@ -231,9 +176,7 @@ def pressure_normals(model: ShellModel) -> np.ndarray:
             "atlas.orientation=[nx, ny, nz], the side the normal n faces (n·e > 0 on average; "
             "the traction is p n, so p > 0 pushes the surface towards it), e.g. "
             "atlas.orientation=[0, 0, 1].")
-    n = np.cross(q.reference[:, 0], q.reference[:, 1])
-    n /= np.linalg.norm(n, axis=1)[:, None]
-    return n * atlas.chart_orientation_[q.group][:, None]
+    return q.normals
 
 
 def displacement_at(model: ShellModel, x) -> tuple[np.ndarray, np.ndarray]:

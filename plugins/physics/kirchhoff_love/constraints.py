@@ -2,9 +2,9 @@
 
 Paper 1 App. D / thesis App. E.2: displacement and rotation conditions are imposed at
 boundary points through Lagrange multipliers (here an augmented Lagrangian, see
-:mod:`.solver`). At a point x on the surface, u(x) = Σ_a p_a U_a and, for Kirchhoff–Love
-kinematics, the linearised change of the unit normal is δn = −(n·u_,α) a^α (a^α the dual
-tangent basis), so:
+:mod:`pointatlas_solvers.augmented_lagrangian`). At a point x on the surface,
+u(x) = Σ_a p_a U_a and, for Kirchhoff–Love kinematics, the linearised change of the unit
+normal is δn = −(n·u_,α) a^α (a^α the dual tangent basis), so:
 
 * displacement rows  e·u(x) = Σ_a p_a e·U_a
 * rotation rows      n·u_,α(x) = Σ_a p_a,α n·U_a        (clamped: δn = 0 ⇔ both vanish)
@@ -23,7 +23,7 @@ from scipy.sparse import coo_matrix, csr_matrix
 
 from pointatlas.errors import InputError
 
-from .selectors import describe, select
+from pointatlas_kit.selectors import describe, select
 
 RIGID_MOTIONS = ("translation along x", "translation along y", "translation along z",
                  "rotation about x", "rotation about y", "rotation about z")

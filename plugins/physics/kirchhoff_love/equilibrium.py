@@ -8,10 +8,11 @@ are both scaled by λ), the augmented Lagrangian of the total potential is
 
 whose gradient at ρ-feasible points is the out-of-balance force R = f_int(U) − λF + Cᵀμ.
 :class:`Equilibrium` evaluates R and Π_ρ (one numba pass gives both), factorises the
-constrained tangent K_T + ρCᵀC (:class:`.solver.ConstrainedSystem`, whose pivot signs flag
+constrained tangent K_T + ρCᵀC (the solvers' :class:`ConstrainedSystem`, whose pivot signs flag
 unstable equilibria), and runs the coarse L-BFGS stage that precedes Newton (thesis L2301:
 "we first obtain a coarse and robust approximation of the equilibrium point with a
 limited-memory BFGS method and then switch to Newton's method combined with line search").
+It is the shell's :class:`pointatlas_solvers.equilibrium_problem.EquilibriumProblem`.
 """
 from __future__ import annotations
 
@@ -28,28 +29,31 @@ class Equilibrium:
         self.F = np.asarray(F, dtype=float).ravel()
         self.constraints = constraints
         self.rho = None   # set by the first factorisation (scale free, from diag K)
+        # what the path followers ask of the problem (pointatlas_solvers.equilibrium_problem)
+        n_nodes, n_real = model.nodes.shape[0], model.points.shape[0]
+        self.n_components, self.row_support = 3, constraints.row_support
+        self.length_scale = float(np.ptp(model.nodes, axis=0).max())
+        # the arc length is measured on the sampled points' DOFs (ghosts nearly free)
+        self.arc_mask = np.repeat(np.arange(n_nodes) < n_real, 3).astype(float)
         # the weak ghost springs of the linear analysis, frozen and part of the energy
         # (½ sᵀU², force sU), so that Newton's fixed point and its tangent agree and the
         # nearly free far ghost DOFs do not drift from one iteration to the next
         from .analysis import ghost_springs
-        from .linear import linear_stiffness
+        from .nonlinear import shell_assembler
 
-        self.springs = ghost_springs(linear_stiffness(self.q, self.mat), model)
+        self.assembler = shell_assembler(self.q, self.mat)   # the kit's, pattern cached
+        self.springs = ghost_springs(self.assembler.tangent(np.zeros(self.assembler.layout
+                                                                     .n_dofs)), model)
 
     def energy_and_forces(self, U: np.ndarray):
         """(W, f_int): strain energy (energy) and internal forces (force), one kernel pass."""
-        from .assembly import densities_and_forces
-
-        dens, f = densities_and_forces(self.q, self.mat, U.reshape(-1, 3), True)
+        W, f = self.assembler.residual(U)
         U = U.ravel()
-        W = float((self.q.weights @ dens).sum()) + 0.5 * float(self.springs @ (U * U))
-        return W, f.ravel() + self.springs * U
+        return W + 0.5 * float(self.springs @ (U * U)), f + self.springs * U
 
     def energy_parts(self, U) -> dict:
         """{'total', 'membrane', 'bending'} strain energy at U (energy)."""
-        from .nonlinear import energy
-
-        return energy(self.q, self.mat, U.reshape(-1, 3))
+        return self.assembler.energy(U)
 
     def residual(self, U, mu, lam):
         """(R, W): out-of-balance force f_int(U) − λF + Cᵀμ and the strain energy."""
@@ -69,16 +73,15 @@ class Equilibrium:
     def system(self, U, shift: float = 0.0):
         """The factorised constrained tangent K_T(U) + ρCᵀC (:class:`ConstrainedSystem`);
         ``shift`` σ (force per length) adds σI, a modified Newton step that descends on an
-        indefinite K_T (:mod:`.stable_equilibrium`)."""
+        indefinite K_T (:mod:`pointatlas_solvers.stable_equilibrium`)."""
         from scipy.sparse import diags
 
-        from .nonlinear import tangent_stiffness
-        from .solver import ConstrainedSystem
+        from pointatlas_solvers.augmented_lagrangian import ConstrainedSystem
 
-        K = (tangent_stiffness(self.q, self.mat, U.reshape(-1, 3))
+        K = (self.assembler.tangent(U)
              + diags(self.springs + shift)).tocsr()
         sys = ConstrainedSystem(K, self.C, self.settings.penalty, self.settings.constraint_tol,
-                                method=self.settings.solver)
+                                backend=self.settings.solver)
         self.rho = sys.rho
         return sys
 

@@ -20,10 +20,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .assembly import MODE_LINEAR, assemble_stiffness
 from .material import ShellMaterial
 from .point_kernels import strain_jacobians_point
-from .quadrature_data import ShellQuadrature
 
 
 @njit(cache=True, nogil=True)
@@ -45,7 +43,7 @@ def _strain_displacement_kernel(indptr, basis, reference, M, B):
                     B[t, r, i] = sb
 
 
-def strain_displacement_matrices(q: ShellQuadrature) -> tuple[np.ndarray, np.ndarray]:
+def strain_displacement_matrices(q) -> tuple[np.ndarray, np.ndarray]:
     """(M, B), each (nnz, 3, 3): membrane and bending strain–displacement matrices per entry.
 
     Entry t of the CSR layout (point q, node a = q.indices[t]) gives M_a, B_a at point q, rows
@@ -55,11 +53,13 @@ def strain_displacement_matrices(q: ShellQuadrature) -> tuple[np.ndarray, np.nda
     nnz = len(q.indices)
     M = np.empty((nnz, 3, 3))
     B = np.empty((nnz, 3, 3))
-    _strain_displacement_kernel(q.indptr, q.basis, q.reference, M, B)
+    _strain_displacement_kernel(q.indptr, q.basis, q.reference_jet(), M, B)
     return M, B
 
 
-def linear_stiffness(q: ShellQuadrature, mat: ShellMaterial):
-    """K (3N, 3N) scipy.sparse.csr_matrix, symmetric, force/length (equation in module doc)."""
-    mat.check()
-    return assemble_stiffness(MODE_LINEAR, q, mat, np.zeros((q.n_nodes, 3)))
+def linear_stiffness(q, mat: ShellMaterial):
+    """K (3N, 3N) scipy.sparse.csr_matrix, symmetric, force/length (equation in module doc):
+    the tangent of the kit's shell energy at U = 0 (:mod:`.nonlinear`)."""
+    from .nonlinear import tangent_stiffness
+
+    return tangent_stiffness(q, mat, np.zeros((q.n_nodes, 3)))

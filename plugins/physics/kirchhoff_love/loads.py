@@ -14,7 +14,7 @@ import numpy as np
 
 from pointatlas.errors import InputError
 
-from .selectors import describe, select
+from pointatlas_kit.selectors import describe, select
 
 
 def _vec(v) -> str:

@@ -8,45 +8,48 @@ Thesis §4.2, Paper 2 §2 (Eqs. for f_int and K_T, thesis L2557–2780), with
 so that, with φ_a = (p_a,1, …, p_a,22) (5,) and ⊗ I_3 for the Cartesian components,
 
     f_a = ∂W/∂U_a = Σ_q w_q Σ_k φ_a,k ∂w/∂y_k,
-    K_ab = ∂²W/∂U_a∂U_b = Σ_q w_q Σ_kl φ_a,k φ_b,l ∂²w/∂y_k∂y_l.
+    K_ab = ∂²W/∂U_a∂U_b = Σ_q w_q Σ_kl φ_a,k φ_b,l ∂²w/∂y_k∂y_l,
 
-Units: U length, W energy, f force, K force/length. Membrane energy uses the Green strain
-ε_αβ = ½(a_αβ − A_αβ); bending energy uses κ_αβ = B_αβ − b_αβ (exact finite rotations:
-a rigid motion has W = 0).
+assembled by the kit's one assembler (:mod:`pointatlas_kit.assembler`) from the shell
+energy kernel (:mod:`.shell_energy`) on an :class:`pointatlas_kit.atlas_quadrature.
+AtlasQuadrature`. Units: U length, W energy, f force, K force/length. Membrane energy uses
+the Green strain ε_αβ = ½(a_αβ − A_αβ); bending energy uses κ_αβ = B_αβ − b_αβ (exact finite
+rotations: a rigid motion has W = 0).
 """
 from __future__ import annotations
 
 import numpy as np
 
-from .assembly import MODE_TANGENT, assemble_stiffness, densities_and_forces
 from .material import ShellMaterial
-from .quadrature_data import ShellQuadrature
 
 
-def energy_density(q: ShellQuadrature, mat: ShellMaterial, U) -> np.ndarray:
+def shell_assembler(q, mat: ShellMaterial):
+    """The kit :class:`~pointatlas_kit.assembler.Assembler` of the shell energy on ``q``."""
+    from pointatlas_kit.assembler import Assembler
+    from pointatlas_kit.fields import FieldLayout
+
+    from .shell_energy import DISPLACEMENT, ShellEnergy
+
+    mat.check()
+    energy = ShellEnergy(mat.young_modulus, mat.poisson_ratio, mat.thickness)
+    return Assembler(q, FieldLayout([DISPLACEMENT], q.n_nodes), [energy])
+
+
+def energy_density(q, mat: ShellMaterial, U) -> np.ndarray:
     """(m,) membrane + bending energy per unit reference area at each point (energy/length²)."""
-    mat.check()
-    dens, _ = densities_and_forces(q, mat, q.check_displacements(U), False)
-    return dens.sum(axis=1)
+    return shell_assembler(q, mat).densities(U).sum(axis=1)
 
 
-def energy(q: ShellQuadrature, mat: ShellMaterial, U) -> dict[str, float]:
+def energy(q, mat: ShellMaterial, U) -> dict[str, float]:
     """{'total', 'membrane', 'bending'}: W = Σ_q w_q w(y_q) and its two parts (energy)."""
-    mat.check()
-    dens, _ = densities_and_forces(q, mat, q.check_displacements(U), False)
-    parts = q.weights @ dens
-    return {"total": float(parts.sum()), "membrane": float(parts[0]),
-            "bending": float(parts[1])}
+    return shell_assembler(q, mat).energy(U)
 
 
-def internal_forces(q: ShellQuadrature, mat: ShellMaterial, U) -> np.ndarray:
+def internal_forces(q, mat: ShellMaterial, U) -> np.ndarray:
     """(N, 3) f = ∂W/∂U (force); DOF 3a + i is f[a, i]."""
-    mat.check()
-    _, f = densities_and_forces(q, mat, q.check_displacements(U), True)
-    return f
+    return shell_assembler(q, mat).residual(U)[1].reshape(-1, 3)
 
 
-def tangent_stiffness(q: ShellQuadrature, mat: ShellMaterial, U):
+def tangent_stiffness(q, mat: ShellMaterial, U):
     """K_T = ∂²W/∂U² (3N, 3N) scipy.sparse.csr_matrix, symmetric (force/length)."""
-    mat.check()
-    return assemble_stiffness(MODE_TANGENT, q, mat, q.check_displacements(U))
+    return shell_assembler(q, mat).tangent(U)

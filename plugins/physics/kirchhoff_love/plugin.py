@@ -1,10 +1,12 @@
 """The ``kirchhoff_love`` physics plugin: thin shells on a point-set atlas (thesis §4)."""
 from __future__ import annotations
 
+from dataclasses import fields
 from typing import ClassVar
 
 from pointatlas.stores_config import stores_config
 
+from .displacement_field import DISPLACEMENT
 from .settings import ShellSettings, check_settings
 
 
@@ -18,12 +20,26 @@ class KirchhoffLove:
     """
 
     Config = ShellSettings
+    #: the kit fields of the shell energy (:mod:`.shell_energy`)
+    fields: ClassVar[tuple] = (DISPLACEMENT,)
     description: ClassVar[str] = (
         "Kirchhoff–Love thin shell on the atlas: linear analysis with supports by augmented "
         "Lagrangian, ghost nodes at boundaries (thesis §4, Papers 1–2).")
 
+    def energies(self, positions=None) -> list:
+        """The shell's kit energies: membrane + bending (:class:`.shell_energy.ShellEnergy`)."""
+        from .shell_energy import ShellEnergy
+
+        return [ShellEnergy(self.young_modulus, self.poisson_ratio, self.thickness)]
+
+    def discrete_energy(self, patch: dict):
+        """The shell energy on quadrature arrays (the conformance suite's view)."""
+        from pointatlas_kit.energy import DiscreteEnergy
+
+        return DiscreteEnergy(self.fields, self.energies(), patch)
+
     def settings(self) -> ShellSettings:
-        return ShellSettings(**{k: getattr(self, k) for k in ShellSettings.__dataclass_fields__})
+        return ShellSettings(**{f.name: getattr(self, f.name) for f in fields(ShellSettings)})
 
     def check_config(self) -> None:
         """The checks of :meth:`shell_settings`, at start-up (before any work)."""
@@ -56,12 +72,9 @@ class KirchhoffLove:
                 "polynomial fit's diffuse derivatives are not the derivatives of its values). "
                 "Remove the override; the polynomial-fit charts are for geometry "
                 "(study=surface_geometry).")
-        return dict(
-            make_embedder=lambda: ctx.plugin("embedder"),
-            make_lme=lambda: ctx.make("approximants", "lme", gamma=a.gamma_lme, tol=a.tol_lme,
-                                      outside="flag"),
-            make_pu=lambda: ctx.make("approximants", "shepard", gamma=a.gamma_pu, tol=a.tol_pu,
-                                     outside="flag"))
+        from pointatlas_kit.surface_model import atlas_factories
+
+        return atlas_factories(ctx, a, physics="kirchhoff_love")
 
     def solve(self, ctx, *, cloud, atlas_settings):
         """Linear analysis of ``cloud``; returns displacement, forces and sizes (xr.Dataset)."""
@@ -77,12 +90,48 @@ class KirchhoffLove:
         warning = model.atlas.refinement_warning()  # failed patches, kept by the user's choice
         if warning:
             ds.attrs["warnings"] = warning
+        # the side the normals (and pressures) of the atlas face: 'outward', the user's
+        # atlas.orientation '[nx, ny, nz]', 'first_chart' (not fixed) or 'none'
+        ds.attrs["normal_orientation"] = str(model.atlas.orientation_)
         return ds
+
+    # -- what studies ask of a solved or built shell (the protocol; no study reads model_) --
+    def evaluate(self, name: str, x):
+        """(values (k, 3), projected points (k, 3)) of field ``name`` ('displacement') at the
+        surface points nearest to ``x`` (k, 3), after :meth:`solve`."""
+        from pointatlas_kit.surface_model import values_at
+
+        model = self._solved()
+        if name != "displacement":
+            from pointatlas.errors import ConfigError
+
+            raise ConfigError(f"kirchhoff_love has the field 'displacement', not {name!r}.")
+        return values_at(model.atlas, model.nodal_displacement, x)
+
+    def export_vtp(self, path, magnification: float = 1.0):
+        """The solved shell as a ParaView .vtp file (points, u, |u|, the deformed shape)."""
+        from .results import write_vtp
+
+        return write_vtp(self._solved(), path, magnification)
+
+    def path_problem(self, ctx, *, cloud, atlas_settings):
+        """A :class:`.path_problem.ShellPath` (equilibrium problem, monitors, point fields)."""
+        from .path_problem import build_path
+
+        return build_path(self, ctx, cloud, atlas_settings)
+
+    def _solved(self):
+        model = getattr(self, "model_", None)
+        if model is None or model.nodal_displacement is None:
+            from pointatlas.errors import PointatlasError
+
+            raise PointatlasError("kirchhoff_love is not solved yet: call solve first.")
+        return model
 
 
 def _as_settings(s: ShellSettings) -> ShellSettings:
     """Supports, loads and selectors as dataclasses even when they came as dicts."""
-    from .selectors import Selector
+    from pointatlas_kit.selectors import Selector
     from .settings import Load, Support
 
     def sel(x):

@@ -66,29 +66,3 @@ def write_vtp(model, path: Path, magnification: float = 1.0) -> Path:
     cloud.save(str(tmp))
     os.replace(tmp, path)
     return path
-
-
-def deformed_picture(ds, window=(900, 700)) -> bytes:
-    """Off-screen pyvista picture (PNG bytes) of the deformed points of a results Dataset,
-    displacement magnified by ``attrs['magnification']``, coloured by |u|."""
-    os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-    import io
-
-    import matplotlib.pyplot as plt
-    import pyvista as pv
-
-    x = ds["position"].values
-    u = ds["displacement_field"].values
-    mag = float(ds.attrs.get("magnification", 1.0))
-    cloud = pv.PolyData(np.ascontiguousarray(x + mag * u))
-    cloud.point_data["|u|"] = np.linalg.norm(u, axis=1)
-    plotter = pv.Plotter(off_screen=True, window_size=window)
-    plotter.set_background("white")
-    plotter.add_mesh(cloud, scalars="|u|", render_points_as_spheres=True, point_size=8,
-                     cmap="viridis", scalar_bar_args={"title": "|u|", "color": "black"})
-    plotter.view_isometric()
-    image = plotter.screenshot(return_img=True)
-    plotter.close()
-    buf = io.BytesIO()
-    plt.imsave(buf, image, format="png")
-    return buf.getvalue()

@@ -24,15 +24,20 @@ length on the boundary points ``where`` picks).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import List, Optional
+from typing import ClassVar, List, Optional
 
+from pointatlas.constraints import Each, Interval, Options, validate_parameters
 from pointatlas.errors import ConfigError
 
-from .selector_spec import Selector
+from pointatlas_kit.selector_spec import Selector
 
 SUPPORT_KINDS = ("clamped", "simply_supported", "symmetry", "diaphragm", "fixed", "displacement")
 LOAD_KINDS = ("point", "surface", "pressure", "line")
-SOLVERS = ("direct", "cg_ilu")
+SOLVERS = ("direct", "cg_ilu", "superlu", "pardiso", "cg_amg", "auto")  # pointatlas_solvers
+
+#: a point or a vector in R^3: three finite numbers
+VECTOR = Each(Interval(float), length=3)
+_POSITIVE = [Interval(float, 0, None, closed="neither")]
 
 
 @dataclass
@@ -45,6 +50,14 @@ class Support:
     components: Optional[List[int]] = None
     value: Optional[List[float]] = None
 
+    # what each kind needs (normal, components, value) is checked in check_settings
+    parameter_constraints: ClassVar[dict[str, list]] = {
+        "kind": [Options(SUPPORT_KINDS)],
+        "normal": [VECTOR, None],
+        "components": [Each(Options((0, 1, 2))), None],   # x, y, z
+        "value": [VECTOR, None],
+    }
+
 
 @dataclass
 class Load:
@@ -55,6 +68,14 @@ class Load:
     force: Optional[List[float]] = None
     pressure: Optional[float] = None
     where: Optional[Selector] = None
+
+    # what each kind needs (at, force, pressure, where) is checked in check_settings
+    parameter_constraints: ClassVar[dict[str, list]] = {
+        "kind": [Options(LOAD_KINDS)],
+        "at": [VECTOR, None],
+        "force": [VECTOR, None],
+        "pressure": [Interval(float), None],
+    }
 
 
 @dataclass
@@ -73,51 +94,46 @@ class ShellSettings:
     constraint_tol: float = 1.0e-10  # relative constraint violation to stop the AL loop
     max_load_offset: float = 0.5     # a point load may lie this many spacings off the surface
 
+    parameter_constraints: ClassVar[dict[str, list]] = {
+        "young_modulus": _POSITIVE,
+        "poisson_ratio": [Interval(float, -1, 0.5, closed="neither")],
+        "thickness": _POSITIVE,
+        "segment_points": [Interval(int, 0, None)],
+        "ghost_layers": [Interval(int, 0, None)],
+        "solver": [Options(SOLVERS)],
+        "penalty": _POSITIVE,
+        "constraint_tol": _POSITIVE,
+        "max_load_offset": _POSITIVE,
+    }
+
 
 def check_settings(s) -> None:
-    """Raise :class:`ConfigError` naming any invalid support, load or number and the fix."""
-    for name in ("young_modulus", "thickness", "penalty", "constraint_tol", "max_load_offset"):
-        v = getattr(s, name)
-        if not (isinstance(v, (int, float)) and v == v and v > 0 and v != float("inf")):
-            raise ConfigError(f"physics.{name} = {v!r} is invalid: it must be a finite number "
-                              "> 0. Give a positive value.")
-    if not -1.0 < s.poisson_ratio < 0.5:
-        raise ConfigError(f"physics.poisson_ratio = {s.poisson_ratio!r} is invalid: it must lie "
-                          "in (-1, 0.5).")
-    if s.solver not in SOLVERS:
-        raise ConfigError(f"physics.solver = {s.solver!r} is unknown; use one of {SOLVERS}.")
-    if s.segment_points < 0:
-        raise ConfigError(f"physics.segment_points = {s.segment_points} must be >= 0.")
-    if s.ghost_layers < 0:
-        raise ConfigError(f"physics.ghost_layers = {s.ghost_layers} must be >= 0.")
+    """Raise :class:`ConfigError` naming any invalid number, choice, support or load and the
+    fix: every value against its declared constraints (``parameter_constraints`` of
+    :class:`ShellSettings`, :class:`Support`, :class:`Load`), then what each kind of support
+    and load needs."""
+    validate_parameters(s, ShellSettings.parameter_constraints, prefix="physics")
     if not s.supports:
         raise ConfigError("physics.supports is empty: the shell is not held anywhere, so its "
                           "stiffness is singular. Add e.g. {kind: clamped, where: {plane: "
                           "[1, 0, 0, 5.0]}}.")
     for i, sup in enumerate(s.supports):
-        if sup.kind not in SUPPORT_KINDS:
-            raise ConfigError(f"physics.supports[{i}].kind = {sup.kind!r} is unknown; use one "
-                              f"of {SUPPORT_KINDS}.")
-        if sup.kind in ("symmetry", "diaphragm") and (not sup.normal or len(sup.normal) != 3):
+        validate_parameters(sup, Support.parameter_constraints, prefix=f"physics.supports[{i}]")
+        if sup.kind in ("symmetry", "diaphragm") and sup.normal is None:
             raise ConfigError(f"physics.supports[{i}] ({sup.kind}) needs normal: [nx, ny, nz], "
                               "the normal of its plane.")
-        if sup.components is not None and any(c not in (0, 1, 2) for c in sup.components):
-            raise ConfigError(f"physics.supports[{i}].components = {sup.components} must be "
-                              "a list of 0, 1, 2 (x, y, z).")
         if sup.kind == "fixed" and not sup.components:
             raise ConfigError(f"physics.supports[{i}] (fixed) needs components, e.g. [2].")
-        if sup.kind == "displacement" and (not sup.value or len(sup.value) != 3):
+        if sup.kind == "displacement" and sup.value is None:
             raise ConfigError(f"physics.supports[{i}] (displacement) needs value: [ux, uy, uz].")
     for i, ld in enumerate(s.loads):
-        if ld.kind not in LOAD_KINDS:
-            raise ConfigError(f"physics.loads[{i}].kind = {ld.kind!r} is unknown; use one of "
-                              f"{LOAD_KINDS}.")
+        validate_parameters(ld, Load.parameter_constraints, prefix=f"physics.loads[{i}]")
         if ld.kind == "pressure":
             if ld.pressure is None:
                 raise ConfigError(f"physics.loads[{i}] (pressure) needs pressure: <value>.")
-        elif not ld.force or len(ld.force) != 3:
+        elif ld.force is None:
             raise ConfigError(f"physics.loads[{i}] ({ld.kind}) needs force: [fx, fy, fz].")
-        if ld.kind == "point" and (not ld.at or len(ld.at) != 3):
+        if ld.kind == "point" and ld.at is None:
             raise ConfigError(f"physics.loads[{i}] (point) needs at: [x, y, z], the point "
                               "where the force acts.")
         if ld.kind == "line" and ld.where is None:
@@ -127,7 +143,7 @@ def check_settings(s) -> None:
 
 def _check_expressions(s) -> None:
     """Selector expressions are parsed and checked at start-up (nothing is evaluated)."""
-    from .expression import parse_expression
+    from pointatlas_kit.expression import parse_expression
 
     for label, items in (("supports", s.supports), ("loads", s.loads)):
         for i, item in enumerate(items):

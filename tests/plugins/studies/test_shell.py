@@ -5,8 +5,8 @@ import pytest
 import xarray as xr
 
 from pointatlas import open_run
-from pointatlas_physics.kirchhoff_love.convergence import (convergence_figures,
-                                                          convergence_table, last_rate)
+from pointatlas_studies.shell_convergence import (convergence_figures,
+                                                  convergence_table, last_rate)
 
 
 def test_plate_run_writes_results_vtp_and_report(tmp_path, run_cli):

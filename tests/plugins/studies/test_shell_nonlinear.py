@@ -80,12 +80,12 @@ def test_branch_switching_needs_arc_length():
     from pointatlas.errors import ConfigError
     from pointatlas_studies.shell_nonlinear import ShellNonlinearStudy
 
-    s = SimpleNamespace(supports=[SimpleNamespace(kind="clamped")])
+    s = SimpleNamespace(imposed=[], has_loads=True)   # what path_problem reports
     study = ShellNonlinearStudy(control="force", branch_switching=True)
     with pytest.raises(ConfigError, match="branch_switching=true needs study.control=arc_length"):
-        study._check_control(np.ones(3), s)
-    ShellNonlinearStudy(control="arc_length", branch_switching=True)._check_control(np.ones(3), s)
+        study._check_control(s)
+    ShellNonlinearStudy(control="arc_length", branch_switching=True)._check_control(s)
     # and the quasi-static snaps of stable_path are for force or displacement control
     with pytest.raises(ConfigError, match="stable_path=true needs study.control=force or disp"):
-        ShellNonlinearStudy(control="arc_length", stable_path=True)._check_control(np.ones(3), s)
-    ShellNonlinearStudy(control="force", stable_path=True)._check_control(np.ones(3), s)
+        ShellNonlinearStudy(control="arc_length", stable_path=True)._check_control(s)
+    ShellNonlinearStudy(control="force", stable_path=True)._check_control(s)

@@ -4,7 +4,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from pointatlas_physics.kirchhoff_love.incremental import Increment
+from pointatlas_solvers.increment import Increment
 from pointatlas_studies.shell_path_results import first_crossing, path_dataset, path_figures
 
 

@@ -76,11 +76,13 @@ def test_quartic_charts_give_curvature_on_random_points(tmp_path):
 
 def test_bad_chart_reproduction_rejected(tmp_path):
     ctx = context(tmp_path, study_cfg={"chart_reproduction": "spline"})
-    with pytest.raises(ConfigError, match="chart_reproduction = 'spline'.*'linear'.*'quartic'"):
+    with pytest.raises(ConfigError,
+                       match="chart_reproduction='spline' is invalid.*'linear'.*'quartic'"):
         SurfaceGeometry(**ctx.config["study"]).run(ctx)
 
 
 def test_bad_chart_hessians_rejected(tmp_path):
     ctx = context(tmp_path, study_cfg={"chart_hessians": "diffuse"})
-    with pytest.raises(ConfigError, match="chart_hessians = 'diffuse'.*'exact'.*'consistent'"):
+    with pytest.raises(ConfigError,
+                       match="chart_hessians='diffuse' is invalid.*'exact'.*'consistent'"):
         SurfaceGeometry(**ctx.config["study"]).run(ctx)

@@ -6,7 +6,7 @@ import pointatlas
 from pointatlas.errors import InputError
 from pointatlas_atlas.settings import AtlasSettings
 from pointatlas_physics.kirchhoff_love.analysis import build_model, displacement_at, solve_linear
-from pointatlas_physics.kirchhoff_love.selectors import Selector
+from pointatlas_kit.selectors import Selector
 from pointatlas_physics.kirchhoff_love.settings import Load, ShellSettings, Support
 
 E, NU, H, L, F = 1.0e6, 0.3, 0.1, 10.0, 200.0

@@ -50,7 +50,7 @@ def test_strain_displacement_matrices_membrane_rows(cylinder_patch):
     M, B = strain_displacement_matrices(q)
     t = 5
     p1, p2 = q.basis[t, 1], q.basis[t, 2]
-    X1, X2 = q.reference[0, 0], q.reference[0, 1]
+    X1, X2 = q.tangents[0, 0], q.tangents[0, 1]
     assert np.allclose(M[t], [p1 * X1, p2 * X2, p2 * X1 + p1 * X2])
     # translation gives no bending strain: Σ_a B_a = 0 at every point
     sums = np.add.reduceat(B, q.indptr[:-1], axis=0)

@@ -12,7 +12,7 @@ from pointatlas_atlas.settings import AtlasSettings
 from pointatlas_physics.kirchhoff_love.analysis import (assemble_loads, build_model,
                                                         displacement_at, pressure_normals,
                                                         solve_linear)
-from pointatlas_physics.kirchhoff_love.selectors import Selector
+from pointatlas_kit.selectors import Selector
 from pointatlas_physics.kirchhoff_love.settings import Load, ShellSettings, Support
 
 E, NU, H, A, P = 1.0e3, 0.3, 0.1, 1.0, 1.0

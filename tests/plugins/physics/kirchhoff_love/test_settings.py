@@ -2,7 +2,7 @@
 import pytest
 
 from pointatlas.errors import ConfigError
-from pointatlas_physics.kirchhoff_love.selectors import Selector
+from pointatlas_kit.selectors import Selector
 from pointatlas_physics.kirchhoff_love.settings import Load, ShellSettings, Support, check_settings
 
 
@@ -15,21 +15,36 @@ def _ok(**kw):
 
 def test_valid_settings_pass():
     check_settings(_ok())
+    for solver in ("direct", "cg_ilu", "superlu", "pardiso", "cg_amg", "auto"):
+        check_settings(_ok(solver=solver))
 
 
 @pytest.mark.parametrize("kw, match", [
-    (dict(thickness=0.0), "thickness"),
-    (dict(young_modulus=-1.0), "young_modulus"),
-    (dict(poisson_ratio=0.5), "poisson_ratio"),
+    (dict(thickness=0.0), r"^physics\.thickness=0\.0 is invalid: it must be a number > 0\."),
+    (dict(young_modulus=-1.0), r"^physics\.young_modulus=-1\.0 is invalid"),
+    (dict(poisson_ratio=0.5), r"^physics\.poisson_ratio=0\.5 is invalid: it must be a number in "
+                              r"\(-1, 0\.5\)\. Pass e\.g\. physics\.poisson_ratio=0\.3\.$"),
+    (dict(poisson_ratio=float("nan")), r"^physics\.poisson_ratio=nan is invalid"),
+    (dict(penalty=float("inf")), r"^physics\.penalty=inf is invalid"),
+    (dict(ghost_layers=-1), r"^physics\.ghost_layers=-1 is invalid: it must be an integer >= 0"),
+    (dict(segment_points=True), r"^physics\.segment_points=True is invalid"),
     (dict(supports=[]), "supports is empty"),
-    (dict(supports=[Support(kind="glued")]), "kind = 'glued'"),
+    (dict(supports=[Support(kind="glued")]), r"^physics\.supports\[0\]\.kind='glued' is invalid: "
+                                             r"it must be one of 'clamped', "),
     (dict(supports=[Support(kind="symmetry")]), "needs normal"),
+    (dict(supports=[Support(kind="symmetry", normal=[1, 0])]),
+     r"^physics\.supports\[0\]\.normal=\[1, 0\] is invalid: it must be a list of 3 items"),
     (dict(supports=[Support(kind="fixed")]), "needs components"),
-    (dict(supports=[Support(kind="fixed", components=[3])]), "components"),
+    (dict(supports=[Support(kind="fixed", components=[3])]),
+     r"^physics\.supports\[0\]\.components=\[3\] is invalid: .*one of 0, 1, 2"),
     (dict(loads=[Load(kind="point", force=[0, 0, 1])]), "needs at"),
+    (dict(loads=[Load(kind="point", at=[0, 0, 0], force=[0, float("nan"), 1])]),
+     r"^physics\.loads\[0\]\.force=\[0, nan, 1\] is invalid"),
     (dict(loads=[Load(kind="pressure")]), "needs pressure"),
     (dict(loads=[Load(kind="line", force=[0, 0, 1])]), "needs where"),
-    (dict(solver="magic"), "solver"),
+    (dict(solver="magic"), r"^physics\.solver='magic' is invalid: it must be one of 'direct', "
+                           r"'cg_ilu', 'superlu', 'pardiso', 'cg_amg', 'auto'\. Pass e\.g\. "
+                           r"physics\.solver=direct\.$"),
 ])
 def test_invalid_settings_are_named(kw, match):
     with pytest.raises(ConfigError, match=match):

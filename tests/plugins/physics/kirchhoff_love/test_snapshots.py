@@ -5,11 +5,8 @@ import numpy as np
 import pytest
 
 from pointatlas.errors import InputError
-from pointatlas_physics.kirchhoff_love.snapshots import (
-    pick_snapshots,
-    point_energy_operator,
-    snapshot_figure,
-)
+from pointatlas_physics.kirchhoff_love.snapshots import point_energy_operator
+from pointatlas_studies.shell_figures import pick_snapshots, snapshot_figure
 
 
 @pytest.fixture(scope="module")

@@ -1,0 +1,133 @@
+"""Numba kernels of the kit's assembler: jets, residual scatter and tangent blocks.
+
+With the jet tables of :class:`.fields.FieldLayout` (``col[r]`` the basis column and
+``dof[r]`` the in-block DOF of jet entry r) and point weights w_q (thesis Eq. 14):
+
+    jet_q[r]         = Σ_a p_a,col[r](ξ_q) U[a, dof[r]]
+    f[a, I]         += w_q Σ_{r: dof[r]=I} p_a,col[r] g_q[r]                 (residual)
+    K_ab[I, J]      += w_q Σ_{r: dof[r]=I} Σ_{s: dof[s]=J} p_a,col[r] H_q[r, s] p_b,col[s]
+
+evaluated, for the tangent, through G[a, I, s] = w_q Σ_{r: dof[r]=I} p_a,col[r] H_q[r, s],
+so a node pair costs B·n_jet operations. The tangent of a point block is accumulated in a
+dense (|L|, |L|, B, B) array over the block's node set L (pairs a ≤ b; K is symmetric) and
+flushed once into the block-CSR data of the plan (:mod:`.assembly_plan`).
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import literally, njit
+
+
+@njit(cache=True, nogil=True)
+def jets_at(points, indptr, indices, basis, U, col, dof, out):
+    """out[k] = jet at point points[k] (see module doc); out (len(points), n_jet)."""
+    n_jet = len(col)
+    for k in range(len(points)):
+        q = points[k]
+        for r in range(n_jet):
+            out[k, r] = 0.0
+        for t in range(indptr[q], indptr[q + 1]):
+            a = indices[t]
+            for r in range(n_jet):
+                out[k, r] += basis[t, col[r]] * U[a, dof[r]]
+
+
+@njit(cache=True, nogil=True)
+def scatter_gradient(points, indptr, indices, basis, weights, g, col, dof, f):
+    """f[a, dof[r]] += w_q p_a,col[r] g[k, r] for the points points[k]."""
+    n_jet = len(col)
+    for k in range(len(points)):
+        q = points[k]
+        w = weights[q]
+        for t in range(indptr[q], indptr[q + 1]):
+            a = indices[t]
+            for r in range(n_jet):
+                f[a, dof[r]] += w * basis[t, col[r]] * g[k, r]
+
+
+@njit(cache=True, nogil=True)
+def tangent_blocks(blk0, blk1, order, block_ptr, first, indptr, indices, basis, weights, H,
+                   col, dof, fcol, fncol, fcomp, foff, fjet, B, n_jet, row_ptr, cols, n_nodes,
+                   data):
+    """Add the tangent of point blocks blk0..blk1 to the block-CSR ``data`` (nnz, B, B).
+
+    H[k] is the energy Hessian at point order[first + k]; ``col``/``dof`` are the jet tables
+    and the per-field tables (first basis column, number of columns, components, DOF offset,
+    jet offset) the same layout by field (:class:`.fields.FieldLayout`). B and the jet size
+    (Python ints) are compile-time constants of the specialisation (numba ``literally``), so the small
+    loops over components unroll.
+    """
+    _tangent_blocks(blk0, blk1, order, block_ptr, first, indptr, indices, basis, weights, H,
+                    col, dof, fcol, fncol, fcomp, foff, fjet, literally(B),
+                    literally(n_jet), row_ptr, cols, n_nodes, data)
+
+
+@njit(cache=True, nogil=True)
+def _tangent_blocks(blk0, blk1, order, block_ptr, first, indptr, indices, basis, weights, H,
+                    col, dof, fcol, fncol, fcomp, foff, fjet, B, n_jet, row_ptr, cols, n_nodes,
+                    data):
+    nf = len(fcol)
+    gl = np.full(n_nodes, -1, np.int64)  # global node -> position in the block's node list
+    for blk in range(blk0, blk1):
+        count = 0
+        for k in range(block_ptr[blk], block_ptr[blk + 1]):
+            count += indptr[order[k] + 1] - indptr[order[k]]
+        nodes = np.empty(count, np.int64)
+        nL = 0
+        for k in range(block_ptr[blk], block_ptr[blk + 1]):
+            q = order[k]
+            for t in range(indptr[q], indptr[q + 1]):
+                A = indices[t]
+                if gl[A] < 0:
+                    gl[A] = nL
+                    nodes[nL] = A
+                    nL += 1
+        Kloc = np.zeros((nL, nL, B, B))
+        blkv = np.empty((B, B))
+        for k in range(block_ptr[blk], block_ptr[blk + 1]):
+            q = order[k]
+            h = k - first
+            t0 = indptr[q]
+            n = indptr[q + 1] - t0
+            w = weights[q]
+            G = np.zeros((n, B, n_jet))
+            for a in range(n):
+                for r in range(n_jet):
+                    pw = w * basis[t0 + a, col[r]]
+                    I = dof[r]
+                    for s in range(n_jet):
+                        G[a, I, s] += pw * H[h, r, s]
+            for a in range(n):
+                la = gl[indices[t0 + a]]
+                for b in range(a, n):
+                    lb = gl[indices[t0 + b]]
+                    blkv[:, :] = 0.0
+                    if nf == 1:  # one field: its components are the whole block
+                        for kk in range(fncol[0]):
+                            c = basis[t0 + b, fcol[0] + kk]
+                            s0 = kk * B
+                            for I in range(B):
+                                for j in range(B):
+                                    blkv[I, j] += G[a, I, s0 + j] * c
+                    else:
+                        for s in range(n_jet):
+                            c = basis[t0 + b, col[s]]
+                            J = dof[s]
+                            for I in range(B):
+                                blkv[I, J] += G[a, I, s] * c
+                    same = b != a and lb == la
+                    for I in range(B):
+                        for J in range(B):
+                            Kloc[la, lb, I, J] += blkv[I, J] + (blkv[J, I] if same else 0.0)
+        for i in range(nL):  # flush: K_ij = Kloc_ij + Kloc_jiᵀ (i ≠ j), K_ii = Kloc_ii
+            A = nodes[i]
+            for p in range(row_ptr[A], row_ptr[A + 1]):
+                j = gl[cols[p]]
+                if j >= 0:
+                    for I in range(B):
+                        for J in range(B):
+                            data[p, I, J] += Kloc[i, j, I, J]
+                            if j != i:
+                                data[p, I, J] += Kloc[j, i, J, I]
+        for i in range(nL):
+            gl[nodes[i]] = -1

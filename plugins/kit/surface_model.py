@@ -1,0 +1,181 @@
+"""From a point cloud to what every physics on a surface needs: boundary, ghosts, atlas,
+quadrature (no physics).
+
+Thesis §4 / Paper 1 §4.1.2 and Paper 2 §3: (1) the boundary of the sampled surface and its
+curves, with ghost nodes beyond it so that the LME basis is not one-sided there; (2) the
+atlas on all nodes with the real markers; (3) the :class:`~.atlas_quadrature.
+AtlasQuadrature` over the sampled surface only (triangles touching a ghost are not
+integrated), with chart derivatives to the order the fields need.
+
+The charts use the run's choices through the registry (``embedder=``, ``approximant=``),
+with the atlas settings' γ and tolerance; :func:`atlas_factories` builds them.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from pointatlas.errors import ConfigError, InputError
+
+#: approximants that can be the basis of a chart (reproduce linear functions)
+CHART_APPROXIMANTS = ("lme",)
+#: approximants whose chart basis has exact derivatives of its values (order 1 and 2)
+DERIVATIVE_APPROXIMANTS = ("lme",)
+
+
+@dataclass
+class SurfaceModel:
+    """A sampled surface ready for physics (arrays in the source's length units)."""
+
+    points: np.ndarray        # (N, 3) the sampled (real) points
+    nodes: np.ndarray         # (N + G, 3) control points: real points, then ghosts
+    boundary: np.ndarray      # (N,) bool
+    curves: list
+    spacing: float            # median nearest-neighbour distance (length)
+    atlas: object
+    quadrature: object        # AtlasQuadrature
+    times: dict = field(default_factory=dict)
+
+    @property
+    def n_ghosts(self) -> int:
+        return self.nodes.shape[0] - self.points.shape[0]
+
+
+def atlas_factories(ctx, atlas_settings, physics: str | None = None, **chart_options) -> dict:
+    """make_embedder / make_lme / make_pu of the run's ``embedder=`` and ``approximant=``
+    choices (through the registry; ``approximant`` unset means ``lme``), with the chart
+    approximant's γ and tolerance from the atlas settings (``atlas.gamma_lme``,
+    ``atlas.tol_lme``) and its other settings from the ``approximant`` group.
+
+    A choice the charts cannot use is refused: an approximant that is not a chart basis
+    (Shepard reproduces only constants), for a ``physics`` one without exact derivatives of
+    its values, and an ``approximant.gamma``/``tol`` set to another value than the atlas's
+    (one place holds them: the atlas settings).
+    """
+    a = atlas_settings
+    name = (ctx.choices.get("approximant") if ctx is not None else None) or "lme"
+    if name not in CHART_APPROXIMANTS:
+        raise ConfigError(
+            f"approximant={name} cannot be the basis of the atlas charts (a chart must "
+            "reproduce linear functions); use approximant=lme (the default). The partition "
+            "of unity is the atlas's Shepard functions (atlas.gamma_pu).")
+    if physics and name not in DERIVATIVE_APPROXIMANTS:
+        raise ConfigError(
+            f"approximant={name} cannot carry {physics}: its fields need the chart basis with "
+            f"exact derivatives of its values; use approximant={DERIVATIVE_APPROXIMANTS[0]}.")
+    chosen = {}
+    if ctx is not None and ctx.choices.get("approximant"):
+        from pointatlas.context import plugin_kwargs
+
+        chosen = plugin_kwargs(ctx.config.get("approximant"))
+        from pointatlas.registry import load_plugin
+
+        defaults = {}
+        config = getattr(load_plugin("approximants", name), "Config", None)
+        if config is not None:
+            import dataclasses
+
+            defaults = {f.name: f.default for f in dataclasses.fields(config)}
+        for key, atlas_key in (("gamma", "gamma_lme"), ("tol", "tol_lme")):
+            if key in chosen and chosen[key] != defaults.get(key) and \
+                    chosen[key] != getattr(a, atlas_key):
+                raise ConfigError(
+                    f"approximant.{key} = {chosen[key]!r} is not what the charts use: the atlas "
+                    f"settings hold it. Write atlas.{atlas_key}={chosen[key]!r} instead.")
+        chosen = {k: v for k, v in chosen.items() if k not in ("gamma", "tol", "outside")}
+    options = {**chosen, **chart_options}
+    return dict(
+        make_embedder=lambda: ctx.plugin("embedder"),
+        make_lme=lambda: ctx.make("approximants", name, gamma=a.gamma_lme, tol=a.tol_lme,
+                                  outside="flag", **options),
+        make_pu=lambda: ctx.make("approximants", "shepard", gamma=a.gamma_pu, tol=a.tol_pu,
+                                 outside="flag"))
+
+
+def build_surface_model(cloud, atlas_settings, make_embedder, make_lme, make_pu, *,
+                        order: int, ghost_layers: int = 2, log=None) -> SurfaceModel:
+    """Boundary, ghosts, atlas and quadrature (basis to chart derivative ``order``)."""
+    import time
+
+    from pointatlas_atlas.atlas import Atlas
+    from pointatlas_atlas.boundary import boundary_curves, boundary_mask
+    from pointatlas_atlas.ghosts import ghost_points
+
+    from .atlas_quadrature import atlas_quadrature
+
+    times: dict = {}
+    P = cloud.points
+    if P.shape[1] != 3:
+        raise InputError(f"a surface physics needs points in R^3; {cloud.name} has "
+                         f"D = {P.shape[1]}.")
+    spacing = float(np.median(cKDTree(P).query(P, k=2)[0][:, 1]))
+    t0 = time.perf_counter()
+    boundary = boundary_mask(P)
+    curves = boundary_curves(P, boundary) if boundary.any() else []
+    G = (ghost_points(P, boundary, layers=ghost_layers)
+         if boundary.any() and ghost_layers > 0 else np.zeros((0, 3)))
+    nodes = np.vstack([P, G])
+    real = np.arange(nodes.shape[0]) < P.shape[0]
+    markers = cloud.markers if cloud.markers is not None else P
+    t1 = time.perf_counter()
+    atlas = Atlas(atlas_settings, make_embedder, make_lme, make_pu)
+    atlas.partition(nodes, markers, keep_basis=True)  # AtlasError: charts fail after repair
+    warning = atlas.refinement_warning()  # only with atlas.allow_failed_patches=true
+    if warning and log is not None:
+        log.warning(warning)
+    t2 = time.perf_counter()
+    atlas.build_charts()
+    t3 = time.perf_counter()
+    atlas.build_quadrature(real=real, keep_basis=True, need_second=order >= 2)
+    quadrature = atlas_quadrature(atlas, order)
+    t4 = time.perf_counter()
+    times.update(boundary=t1 - t0, partition=t2 - t1, charts=t3 - t2, quadrature=t4 - t3)
+    touched = np.zeros(nodes.shape[0], bool)
+    touched[quadrature.indices] = True
+    lonely = np.flatnonzero(real & ~touched)
+    if lonely.size:
+        raise InputError(
+            f"{lonely.size} point(s) (first: {lonely[:5].tolist()}) lie in no chart's "
+            "quadrature: the point cloud is too sparse or irregular there for the chart "
+            "support. Sample the surface more densely or lower atlas.markers_per_patch.")
+    if log is not None:
+        log.info("%d points (%d on the boundary, %d curves) + %d ghosts; %d patches, "
+                 "%d quadrature points", P.shape[0], int(boundary.sum()), len(curves),
+                 G.shape[0], len(atlas.charts_), quadrature.n_points)
+    return SurfaceModel(P, nodes, boundary, curves, spacing, atlas, quadrature, times)
+
+
+def values_at_nodes(atlas, U_nodes: np.ndarray, nodes) -> np.ndarray:
+    """Field values u(x_a) = Σ_b p_b(ξ_a) U_b at control points ``nodes`` (k, components)."""
+    from pointatlas_atlas.evaluation import basis_at_nodes
+
+    basis, _, _ = basis_at_nodes(atlas, np.asarray(nodes, np.int64), order=0)
+    return basis.to_csr(U_nodes.shape[0]) @ U_nodes
+
+
+def values_at(atlas, U_nodes: np.ndarray, x) -> tuple[np.ndarray, np.ndarray]:
+    """(u (k, components), projected points (k, 3)) at the surface points nearest to ``x``."""
+    from pointatlas_atlas.evaluation import basis_at
+    from pointatlas_atlas.projection import closest_point
+
+    proj = closest_point(atlas, np.atleast_2d(np.asarray(x, dtype=np.float64)))
+    b = basis_at(atlas, proj.chart, proj.xi, order=0)
+    return b.to_csr(U_nodes.shape[0]) @ U_nodes, proj.point
+
+
+def ghost_springs(diagonal: np.ndarray, model: SurfaceModel, block: int,
+                  eps: float = 1e-10) -> np.ndarray:
+    """(block·n_nodes,) spring stiffness per DOF: ε·mean(diag K) on ghost DOFs and
+    mean(diag K) on DOFs no quadrature point sees. A ghost far out carries basis functions
+    that are ~0 on the sampled surface (cut off by the LME tolerance), so its DOFs are nearly
+    free: the spring pins them without changing the field on the surface noticeably."""
+    n = model.nodes.shape[0]
+    scale = float(np.mean(diagonal))
+    node_w = np.zeros(n)
+    node_w[model.points.shape[0]:] = eps
+    seen = np.zeros(n, bool)
+    seen[model.quadrature.indices] = True
+    node_w[~seen] = 1.0
+    return np.repeat(node_w * scale, block)

@@ -1,0 +1,111 @@
+"""The kit's one assembler: FD consistency for one and several fields, refusals."""
+import numpy as np
+import pytest
+
+from pointatlas.errors import ConfigError
+from pointatlas.physics_conformance import check_discrete_energy, curved_patch
+from pointatlas_kit.assembler import Assembler
+from pointatlas_kit.energy import DiscreteEnergy, LinearSource
+from pointatlas_kit.fields import Field, FieldLayout
+
+PHI = Field("phase", components=1, order=1)
+DISP = Field("displacement", components=3, order=2, value=False)
+
+
+class Coupled:
+    """W = (½ + φ²) |δy|² + φ_,1 φ_,2: a made-up energy of two fields (jet: φ, φ_,1, φ_,2,
+    then the 15 displacement derivatives), nonlinear and coupling both."""
+
+    fields = (PHI, DISP)
+    density_names = ("coupled",)
+    frame_invariant = False
+
+    def point_data(self, q):
+        return np.zeros((q.n_points, 1))
+
+    def evaluate(self, jets, data, want):
+        p, p1, p2, y = jets[:, 0], jets[:, 1], jets[:, 2], jets[:, 3:]
+        s = (y * y).sum(axis=1)
+        a = 0.5 + p * p
+        dens = (a * s + p1 * p2)[:, None]
+        g = H = None
+        if want >= 1:
+            g = np.zeros_like(jets)
+            g[:, 0], g[:, 1], g[:, 2] = 2 * p * s, p2, p1
+            g[:, 3:] = 2 * a[:, None] * y
+        if want >= 2:
+            n = jets.shape[1]
+            H = np.zeros((len(jets), n, n))
+            H[:, 0, 0] = 2 * s
+            H[:, 1, 2] = H[:, 2, 1] = 1.0
+            H[:, 0, 3:] = H[:, 3:, 0] = 4 * p[:, None] * y
+            H[:, 3:, 3:] = 2 * a[:, None, None] * np.eye(n - 3)
+        return dens, g, H
+
+
+class Physics:
+    """Just enough of a physics for the conformance check."""
+
+    def __init__(self, fields, energies):
+        self.fields, self._energies = fields, energies
+
+    def discrete_energy(self, patch):
+        return DiscreteEnergy(self.fields, self._energies, patch)
+
+
+def test_two_fields_pass_the_conformance_check():
+    check_discrete_energy(Physics((PHI, DISP), [Coupled()]))
+
+
+def test_dof_numbering_is_node_major():
+    L = FieldLayout((PHI, DISP), n_nodes=5)
+    assert L.block == 4 and L.n_dofs == 20
+    assert L.dofs("phase", [0, 2]).ravel().tolist() == [0, 8]
+    assert L.dofs("displacement", [1], [2]).ravel().tolist() == [4 + 1 + 2]
+    assert L.jet_size == 3 + 15
+
+
+def test_a_wrong_tangent_is_caught_and_named():
+    class WrongTangent(Coupled):
+        def evaluate(self, jets, data, want):
+            d, g, H = super().evaluate(jets, data, want)
+            if H is not None:
+                H = 1.01 * H
+            return d, g, H
+
+    with pytest.raises(AssertionError, match=r"tangent disagrees .* worst entry K\["):
+        check_discrete_energy(Physics((PHI, DISP), [WrongTangent()]))
+
+
+def test_a_wrong_residual_is_caught():
+    class WrongGradient(Coupled):
+        def evaluate(self, jets, data, want):
+            d, g, H = super().evaluate(jets, data, want)
+            if g is not None:
+                g = g.copy()
+                g[:, 0] *= 2.0
+            return d, g, H
+
+    with pytest.raises(AssertionError, match="residual disagrees"):
+        check_discrete_energy(Physics((PHI, DISP), [WrongGradient()]))
+
+
+def test_refusals_name_the_fix():
+    patch = curved_patch(n=4)
+    with pytest.raises(ConfigError, match=r"declared but no energy uses them"):
+        DiscreteEnergy((PHI, DISP), [LinearSource(PHI, np.zeros(len(patch["weights"])))], patch)
+    with pytest.raises(ConfigError, match="does not declare"):
+        DiscreteEnergy((PHI,), [Coupled()], patch)
+    with pytest.raises(ConfigError, match="components 0..0"):
+        FieldLayout((PHI,), 3).dofs("phase", [0], [1])
+    with pytest.raises(ConfigError, match="order"):
+        Field("bad", components=1, order=3)
+
+
+def test_linear_source_is_external_work():
+    """R(0) = −∫ s p_a dΓ: the load vector of a source s = 1 sums to minus the area."""
+    patch = curved_patch(n=5)
+    de = DiscreteEnergy((PHI,), [LinearSource(PHI, np.ones(len(patch["weights"])))], patch)
+    _, R = de.residual(np.zeros(de.n_dofs))
+    assert np.isclose(R.sum(), -patch["weights"].sum(), rtol=1e-10)
+    assert Assembler  # the public entry point

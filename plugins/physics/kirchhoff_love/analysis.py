@@ -11,36 +11,26 @@ from __future__ import annotations
 
 import time
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from pointatlas.errors import InputError
+from pointatlas_kit.surface_model import SurfaceModel
 
 
 @dataclass
-class ShellModel:
-    """Everything a solve needs and produces (arrays in the source's length units)."""
+class ShellModel(SurfaceModel):
+    """A :class:`pointatlas_kit.surface_model.SurfaceModel` with what a shell solve needs
+    and produces (arrays in the source's length units)."""
 
-    points: np.ndarray            # (N, 3) the sampled (real) points
-    nodes: np.ndarray             # (N + G, 3) control points: real points, then ghosts
-    boundary: np.ndarray          # (N,) bool
-    curves: list
-    spacing: float
-    atlas: object
-    quadrature: object            # pointatlas_kit AtlasQuadrature over all charts
-    material: object
+    material: object = None
     stiffness: object = None
     forces: np.ndarray | None = None          # (N + G, 3)
     constraints: object = None
     nodal_displacement: np.ndarray | None = None  # (N + G, 3) U
     displacement: np.ndarray | None = None    # (N, 3) u(x_a)
     solve_info: object = None
-    times: dict = field(default_factory=dict)
-
-    @property
-    def n_ghosts(self) -> int:
-        return self.nodes.shape[0] - self.points.shape[0]
 
     @property
     def dof(self) -> int:
@@ -68,7 +58,7 @@ def build_model(cloud, settings, atlas_settings, make_embedder, make_lme, make_p
     m = build_surface_model(cloud, atlas_settings, make_embedder, make_lme, make_pu, order=2,
                             ghost_layers=settings.ghost_layers, log=log)
     return ShellModel(m.points, m.nodes, m.boundary, m.curves, m.spacing, m.atlas,
-                      m.quadrature, material, times=m.times)
+                      m.quadrature, m.times, material=material)
 
 
 def solve_linear(model: ShellModel, settings, log=None) -> ShellModel:

@@ -94,6 +94,29 @@ def atlas_factories(ctx, atlas_settings, physics: str | None = None, **chart_opt
                                  outside="flag"))
 
 
+def check_surface_cloud(cloud, n_neighbors: int) -> None:
+    """Refuse (InputError, one line with where and the fix) a cloud a physics on one smooth
+    surface cannot carry: creases or non-disc neighbourhoods
+    (:mod:`pointatlas_atlas.cloud_checks`), isolated points, or several components (a
+    physics is solved on one connected surface; give each component its own run)."""
+    from pointatlas_atlas.cloud_checks import check_cloud, components_message, refusal, where
+
+    check = check_cloud(cloud.points, n_neighbors)
+    reason = refusal(cloud.points, check)
+    if reason:
+        raise InputError(f"{cloud.name}: {reason}")
+    comp = check.components
+    if len(comp.sizes) > 1:
+        raise InputError(f"{cloud.name}: {components_message(comp)}; a physics is solved on "
+                         "one connected surface: give each component its own run (e.g. "
+                         "source=file with the points of one part).")
+    if comp.n_isolated:
+        iso = comp.labels < 0
+        raise InputError(f"{cloud.name}: {comp.n_isolated} isolated point(s), far from the "
+                         f"surface, e.g. near {where(cloud.points[iso])}: remove them (they "
+                         "would carry nodes of no chart).")
+
+
 def build_surface_model(cloud, atlas_settings, make_embedder, make_lme, make_pu, *,
                         order: int, ghost_layers: int = 2, log=None) -> SurfaceModel:
     """Boundary, ghosts, atlas and quadrature (basis to chart derivative ``order``)."""
@@ -112,6 +135,7 @@ def build_surface_model(cloud, atlas_settings, make_embedder, make_lme, make_pu,
                          f"D = {P.shape[1]}.")
     spacing = float(np.median(cKDTree(P).query(P, k=2)[0][:, 1]))
     t0 = time.perf_counter()
+    check_surface_cloud(cloud, atlas_settings.graph_neighbors)
     boundary = boundary_mask(P)
     curves = boundary_curves(P, boundary) if boundary.any() else []
     G = (ghost_points(P, boundary, layers=ghost_layers)

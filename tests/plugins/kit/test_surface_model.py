@@ -15,3 +15,32 @@ def test_an_approximant_gamma_the_charts_do_not_use_is_refused(run_cli, tmp_path
                 cwd=tmp_path)
     assert r.returncode != 0
     assert "Write atlas.gamma_lme=2.5 instead" in r.stderr + r.stdout
+
+
+def _sphere(n, centre=(0.0, 0.0, 0.0)):
+    """A Fibonacci sphere made here (not by a project source)."""
+    import numpy as np
+
+    i = np.arange(n) + 0.5
+    z = 1 - 2 * i / n
+    phi = np.pi * (1 + 5 ** 0.5) * i
+    r = np.sqrt(1 - z * z)
+    return np.column_stack([r * np.cos(phi), r * np.sin(phi), z]) + np.asarray(centre)
+
+
+def test_a_physics_refuses_creases_and_several_components():
+    import numpy as np
+    import pytest
+
+    from pointatlas.errors import InputError
+    from pointatlas.pointcloud import PointCloud
+    from pointatlas_kit.surface_model import check_surface_cloud
+
+    from ..atlas.test_cloud_checks import cube_surface
+
+    check_surface_cloud(PointCloud(points=_sphere(800), name="sphere"), 10)  # smooth: passes
+    with pytest.raises(InputError, match="creases"):
+        check_surface_cloud(PointCloud(points=cube_surface(14), name="cube"), 10)
+    two = np.vstack([_sphere(600), _sphere(600, (5.0, 0.0, 0.0))])
+    with pytest.raises(InputError, match="2 connected components.*one connected surface"):
+        check_surface_cloud(PointCloud(points=two, name="two spheres"), 10)

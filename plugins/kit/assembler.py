@@ -25,6 +25,17 @@ from .fields import FieldLayout
 
 #: points whose energy Hessians are held at once by one thread
 CHUNK = 4096
+_blas = None
+
+
+def _one_blas_thread():
+    """Context limiting BLAS to one thread (the controller scans the libraries once)."""
+    global _blas
+    from threadpoolctl import ThreadpoolController
+
+    if _blas is None:
+        _blas = ThreadpoolController()
+    return _blas.limit(limits=1, user_api="blas")
 
 
 class _Term:
@@ -167,7 +178,8 @@ class Assembler:
                 c0 = c1
             return data
 
-        parts = run_threads(work, [tuple(int(x) for x in r) for r in plan.thread_bounds])
+        with _one_blas_thread():  # the point products are small: BLAS threads only contend
+            parts = run_threads(work, [tuple(int(x) for x in r) for r in plan.thread_bounds])
         data = parts[0]
         for extra in parts[1:]:
             data += extra

@@ -8,9 +8,10 @@ With the jet tables of :class:`.fields.FieldLayout` (``col[r]`` the basis column
     K_ab[I, J]      += w_q Σ_{r: dof[r]=I} Σ_{s: dof[s]=J} p_a,col[r] H_q[r, s] p_b,col[s]
 
 evaluated, for the tangent, through G[a, I, s] = w_q Σ_{r: dof[r]=I} p_a,col[r] H_q[r, s],
-so a node pair costs B·n_jet operations. The tangent of a point block is accumulated in a
-dense (|L|, |L|, B, B) array over the block's node set L (pairs a ≤ b; K is symmetric) and
-flushed once into the block-CSR data of the plan (:mod:`.assembly_plan`).
+so a node pair costs B·n_jet operations; with one field the products of a point are one
+matrix product (BLAS, all node pairs). The tangent of a point block is accumulated in a
+dense (|L|, |L|, B, B) array over the block's node set L (several fields: pairs a ≤ b, K
+being symmetric) and flushed once into the block-CSR data of the plan (:mod:`.assembly_plan`).
 """
 from __future__ import annotations
 
@@ -90,6 +91,10 @@ def _tangent_blocks(blk0, blk1, order, block_ptr, first, indptr, indices, basis,
             t0 = indptr[q]
             n = indptr[q + 1] - t0
             w = weights[q]
+            if nf == 1:
+                _one_field_point(t0, n, w, basis, H[h], fcol[0], fncol[0], B, indices, gl,
+                                 Kloc)
+                continue
             G = np.zeros((n, B, n_jet))
             for a in range(n):
                 for r in range(n_jet):
@@ -102,24 +107,16 @@ def _tangent_blocks(blk0, blk1, order, block_ptr, first, indptr, indices, basis,
                 for b in range(a, n):
                     lb = gl[indices[t0 + b]]
                     blkv[:, :] = 0.0
-                    if nf == 1:  # one field: its components are the whole block
-                        for kk in range(fncol[0]):
-                            c = basis[t0 + b, fcol[0] + kk]
-                            s0 = kk * B
-                            for I in range(B):
-                                for j in range(B):
-                                    blkv[I, j] += G[a, I, s0 + j] * c
-                    else:
-                        for s in range(n_jet):
-                            c = basis[t0 + b, col[s]]
-                            J = dof[s]
-                            for I in range(B):
-                                blkv[I, J] += G[a, I, s] * c
+                    for s in range(n_jet):
+                        c = basis[t0 + b, col[s]]
+                        J = dof[s]
+                        for I in range(B):
+                            blkv[I, J] += G[a, I, s] * c
                     same = b != a and lb == la
                     for I in range(B):
                         for J in range(B):
                             Kloc[la, lb, I, J] += blkv[I, J] + (blkv[J, I] if same else 0.0)
-        for i in range(nL):  # flush: K_ij = Kloc_ij + Kloc_jiᵀ (i ≠ j), K_ii = Kloc_ii
+        for i in range(nL):  # flush (several fields: K_ij = Kloc_ij + Kloc_jiᵀ, i ≠ j)
             A = nodes[i]
             for p in range(row_ptr[A], row_ptr[A + 1]):
                 j = gl[cols[p]]
@@ -127,7 +124,37 @@ def _tangent_blocks(blk0, blk1, order, block_ptr, first, indptr, indices, basis,
                     for I in range(B):
                         for J in range(B):
                             data[p, I, J] += Kloc[i, j, I, J]
-                            if j != i:
+                            if j != i and nf > 1:  # several fields: pairs a ≤ b only
                                 data[p, I, J] += Kloc[j, i, J, I]
         for i in range(nL):
             gl[nodes[i]] = -1
+
+
+@njit(cache=True, nogil=True)
+def _one_field_point(t0, n, w, basis, Hq, c0, nc, B, indices, gl, Kloc):
+    """Kloc[a, b] += K_ab of one point of a single-field layout (jet (nc, B) row by row):
+    K_ab[i, j] = Σ_kk p_b,kk G2[kk, (a, i, j)], G2[kk, (a, i, j)] = w Σ_k' p_a,k' H[k'B + i,
+    kk B + j], as one matrix product Φ G2 (BLAS; all pairs, no symmetry bookkeeping)."""
+    Phi = np.empty((n, nc))
+    for a in range(n):
+        for kk in range(nc):
+            Phi[a, kk] = basis[t0 + a, c0 + kk]
+    G2 = np.zeros((nc, n * B * B))
+    for a in range(n):
+        for kp in range(nc):
+            p = w * Phi[a, kp]
+            if p != 0.0:
+                for i in range(B):
+                    r = kp * B + i
+                    for kk in range(nc):
+                        o = a * B * B + i * B
+                        for j in range(B):
+                            G2[kk, o + j] += p * Hq[r, kk * B + j]
+    P = np.dot(Phi, G2)  # P[b, (a, i, j)] = K_ab[i, j]
+    for a in range(n):
+        la = gl[indices[t0 + a]]
+        for b in range(n):
+            lb = gl[indices[t0 + b]]
+            for i in range(B):
+                for j in range(B):
+                    Kloc[la, lb, i, j] += P[b, a * B * B + i * B + j]

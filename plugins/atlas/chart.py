@@ -202,7 +202,7 @@ DENSE_SOLVE_MAX = 2000
 _blas_controller = None
 
 
-def _one_blas_thread():
+def one_blas_thread():
     """Context limiting BLAS to one thread (the controller scans the libraries once)."""
     global _blas_controller
     from threadpoolctl import ThreadpoolController
@@ -231,7 +231,7 @@ def interpolating_control_points(lme, xi: np.ndarray, samples: np.ndarray,
     if n <= DENSE_SOLVE_MAX:
         # a few hundred nodes with ~80 non-zeros a row: one-thread LAPACK LU is ~7x faster
         # than SuperLU (and threaded BLAS only fights the numba threads at this size)
-        with _one_blas_thread():
+        with one_blas_thread():
             return np.linalg.solve(M.toarray(), samples)
     return splu(M.tocsc()).solve(samples)
 

@@ -100,12 +100,12 @@ def serial_threads():
     eigendecomposition took 7x longer on two busy BLAS threads than on one, measured)."""
     import numba
 
-    from .chart import _one_blas_thread
+    from .chart import one_blas_thread
 
     threads = numba.get_num_threads()
     numba.set_num_threads(1)
     try:
-        with _one_blas_thread():
+        with one_blas_thread():
             yield
     finally:
         numba.set_num_threads(threads)

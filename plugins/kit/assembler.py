@@ -25,17 +25,6 @@ from .fields import FieldLayout
 
 #: points whose energy Hessians are held at once by one thread
 CHUNK = 4096
-_blas = None
-
-
-def _one_blas_thread():
-    """Context limiting BLAS to one thread (the controller scans the libraries once)."""
-    global _blas
-    from threadpoolctl import ThreadpoolController
-
-    if _blas is None:
-        _blas = ThreadpoolController()
-    return _blas.limit(limits=1, user_api="blas")
 
 
 class _Term:
@@ -178,7 +167,9 @@ class Assembler:
                 c0 = c1
             return data
 
-        with _one_blas_thread():  # the point products are small: BLAS threads only contend
+        from pointatlas_atlas.chart import one_blas_thread
+
+        with one_blas_thread():  # the point products are small: BLAS threads only contend
             parts = run_threads(work, [tuple(int(x) for x in r) for r in plan.thread_bounds])
         data = parts[0]
         for extra in parts[1:]:

@@ -67,17 +67,14 @@ def atlas_factories(ctx, atlas_settings, physics: str | None = None, **chart_opt
             f"exact derivatives of its values; use approximant={DERIVATIVE_APPROXIMANTS[0]}.")
     chosen = {}
     if ctx is not None and ctx.choices.get("approximant"):
-        from pointatlas.context import plugin_kwargs
+        import dataclasses
 
-        chosen = plugin_kwargs(ctx.config.get("approximant"))
+        from pointatlas.context import plugin_kwargs
         from pointatlas.registry import load_plugin
 
-        defaults = {}
+        chosen = plugin_kwargs(ctx.config.get("approximant"))
         config = getattr(load_plugin("approximants", name), "Config", None)
-        if config is not None:
-            import dataclasses
-
-            defaults = {f.name: f.default for f in dataclasses.fields(config)}
+        defaults = {f.name: f.default for f in dataclasses.fields(config)} if config else {}
         for key, atlas_key in (("gamma", "gamma_lme"), ("tol", "tol_lme")):
             if key in chosen and chosen[key] != defaults.get(key) and \
                     chosen[key] != getattr(a, atlas_key):

@@ -128,19 +128,14 @@ def assemble_supports(model: ShellModel, settings):
     return cons
 
 
-def ghost_springs(K, model: ShellModel, eps: float = 1e-10) -> np.ndarray:
-    """(3(N+G),) weak springs on ghost DOFs (:func:`pointatlas_kit.surface_model.
-    ghost_springs` with the diagonal of K)."""
-    from pointatlas_kit.surface_model import ghost_springs as springs
-
-    return springs(K.diagonal(), model, 3, eps)
-
-
 def regularize_ghosts(K, model: ShellModel, eps: float = 1e-10):
-    """K plus the :func:`ghost_springs` on its diagonal."""
+    """K plus the weak ghost springs (:func:`pointatlas_kit.surface_model.ghost_springs`)
+    on its diagonal."""
     from scipy.sparse import diags
 
-    return (K + diags(ghost_springs(K, model, eps))).tocsr()
+    from pointatlas_kit.surface_model import ghost_springs
+
+    return (K + diags(ghost_springs(K.diagonal(), model, 3, eps))).tocsr()
 
 
 def pressure_normals(model: ShellModel) -> np.ndarray:
@@ -170,11 +165,9 @@ def pressure_normals(model: ShellModel) -> np.ndarray:
 
 
 def displacement_at(model: ShellModel, x) -> tuple[np.ndarray, np.ndarray]:
-    """(u (3,), projected point (3,)) at the surface point nearest to ``x``."""
-    from pointatlas_atlas.evaluation import basis_at
-    from pointatlas_atlas.projection import closest_point
+    """(u (3,), projected point (3,)) at the surface point nearest to ``x``
+    (:func:`pointatlas_kit.surface_model.values_at`)."""
+    from pointatlas_kit.surface_model import values_at
 
-    proj = closest_point(model.atlas, np.asarray(x, dtype=np.float64).reshape(1, 3))
-    b = basis_at(model.atlas, proj.chart, proj.xi, order=0)
-    u = b.to_csr(model.nodes.shape[0]) @ model.nodal_displacement
-    return u[0], proj.point[0]
+    u, p = values_at(model.atlas, model.nodal_displacement, np.reshape(x, (1, 3)))
+    return u[0], p[0]

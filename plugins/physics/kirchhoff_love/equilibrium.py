@@ -38,12 +38,13 @@ class Equilibrium:
         # the weak ghost springs of the linear analysis, frozen and part of the energy
         # (½ sᵀU², force sU), so that Newton's fixed point and its tangent agree and the
         # nearly free far ghost DOFs do not drift from one iteration to the next
-        from .analysis import ghost_springs
+        from pointatlas_kit.surface_model import ghost_springs
+
         from .nonlinear import shell_assembler
 
         self.assembler = shell_assembler(self.q, self.mat)   # the kit's, pattern cached
-        self.springs = ghost_springs(self.assembler.tangent(np.zeros(self.assembler.layout
-                                                                     .n_dofs)), model)
+        K0 = self.assembler.tangent(np.zeros(self.assembler.layout.n_dofs))
+        self.springs = ghost_springs(K0.diagonal(), model, 3)
 
     def energy_and_forces(self, U: np.ndarray):
         """(W, f_int): strain energy (energy) and internal forces (force), one kernel pass."""

@@ -44,15 +44,13 @@ class ShellPath:
 
     def point_fields(self):
         """U -> (u(x_a) (n, 3), energy density (n, 3): membrane, bending, total) at the
-        sampled points; the bases are computed once."""
-        from pointatlas_kit.atlas_quadrature import node_quadrature
-
+        sampled points; the bases are evaluated once, for both (the energy operator's
+        quadrature at the points also interpolates u)."""
         from .snapshots import point_energy_operator
 
         n = self.points.shape[0]
-        q, rows = node_quadrature(self.model.atlas, np.arange(n), order=0)
-        B = q.interpolation()
         energy_at = point_energy_operator(self.model)
+        B, rows = energy_at.quadrature.interpolation(), energy_at.rows
 
         def fields(U):
             u = np.full((n, 3), np.nan)

@@ -20,13 +20,10 @@ _TRIANGLE_RULE = (np.array([[2 / 3, 1 / 6, 1 / 6], [1 / 6, 2 / 3, 1 / 6], [1 / 6
                   np.full(3, 1 / 3))
 
 
-def curved_patch(n: int = 6, seed: int = 0) -> dict:
-    """Quadrature arrays of a small doubly curved patch (z = 0.3 x² − 0.2 xy + 0.25 y² on a
-    jittered n × n grid of [0, 1]²) with the LME basis (γ = 0.8) of the registry."""
-    from scipy.spatial import Delaunay
-
-    from .registry import load_plugin
-
+def curved_points(n: int = 6, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """(ξ (n², 2), P (n², 3)): a jittered n × n grid ξ of [0, 1]² (the edge points stay on the
+    edges, the inner ones move by up to 0.15/n) lifted to the doubly curved open patch
+    z = 0.3 x² − 0.2 xy + 0.25 y² (lengths in the units of the square's side)."""
     rng = np.random.default_rng(seed)
     g = np.linspace(0.0, 1.0, n)
     xi = np.array(np.meshgrid(g, g, indexing="ij")).reshape(2, -1).T
@@ -34,6 +31,17 @@ def curved_patch(n: int = 6, seed: int = 0) -> dict:
     xi[inner] += 0.15 / n * rng.uniform(-1, 1, (int(inner.sum()), 2))
     P = np.column_stack([xi, 0.3 * xi[:, 0] ** 2 - 0.2 * xi[:, 0] * xi[:, 1]
                          + 0.25 * xi[:, 1] ** 2])
+    return xi, P
+
+
+def curved_patch(n: int = 6, seed: int = 0) -> dict:
+    """Quadrature arrays of a small doubly curved patch (:func:`curved_points`) with the LME
+    basis (γ = 0.8) of the registry."""
+    from scipy.spatial import Delaunay
+
+    from .registry import load_plugin
+
+    xi, P = curved_points(n, seed)
     tri = Delaunay(xi).simplices
     bary, wr = _TRIANGLE_RULE
     V = xi[tri]                                   # (t, 3, 2)

@@ -7,6 +7,7 @@ Each ``check_*`` raises ``AssertionError`` naming the broken rule.
 """
 from __future__ import annotations
 
+import copy
 import dataclasses
 import inspect
 from typing import Any
@@ -176,23 +177,56 @@ def check_approximant(cls: type, *, dim: int = 2, reproduces_linear: bool = Fals
         np.testing.assert_allclose(rec, points, atol=1e-8, err_msg="linear reproduction fails")
 
 
-def check_physics(cls: type, **kwargs: Any) -> None:
+def check_physics(cls: type, *, solve_case: dict | None = None, **kwargs: Any) -> None:
     """The plugin contract, ``solve``, declared ``fields`` and, for a physics written on the
     kit (``discrete_energy``), its residual and tangent against finite differences of its
     energy on a small curved patch, a symmetric tangent and rigid-motion invariance where
-    claimed (:mod:`pointatlas.physics_conformance`). ``kwargs``: Config values to use."""
+    claimed (:mod:`pointatlas.physics_conformance`). ``kwargs``: Config values to use.
+
+    With ``solve_case`` (Config values of a small solvable problem on an open curved patch;
+    default: the class attribute ``conformance_case``, if any) the physics built from them
+    (merged with ``kwargs``) is solved on that patch and the Dataset ``solve`` returns is
+    checked: named dims, ``long_name``/``units`` on every variable, the declared fields over
+    the ``point`` coordinate, finite values (:mod:`pointatlas.physics_dataset_check`).
+    """
     check_contract(cls)
     name = cls.__name__
     assert callable(getattr(cls, "solve", None)), f"{name} must define solve(ctx, ...)"
-    if not callable(getattr(cls, "discrete_energy", None)):
-        return
     fields = getattr(cls, "fields", ())
-    assert fields and all(hasattr(f, "name") and hasattr(f, "components") and
-                          hasattr(f, "order") for f in fields), (
-        f"{name}.fields must declare the fields of its energies (kit Field objects)")
-    from .physics_conformance import check_discrete_energy
+    if callable(getattr(cls, "discrete_energy", None)):
+        assert fields and all(hasattr(f, "name") and hasattr(f, "components") and
+                              hasattr(f, "order") for f in fields), (
+            f"{name}.fields must declare the fields of its energies (kit Field objects)")
+        from .physics_conformance import check_discrete_energy
 
-    check_discrete_energy(cls(**kwargs))
+        check_discrete_energy(cls(**kwargs))
+    case = getattr(cls, "conformance_case", None) if solve_case is None else solve_case
+    if case is not None:
+        _check_solve_case(cls, case, fields, kwargs)
+
+
+def _check_solve_case(cls: type, case: Any, fields, kwargs: dict) -> None:
+    """Solve ``case`` on the conformance patch; check the Dataset and the fields it holds."""
+    from .config_check import check_plugin_settings
+    from .physics_dataset_check import check_physics_dataset, solve_conformance_case
+
+    name = cls.__name__
+    assert isinstance(case, dict), (
+        f"{name}.conformance_case must be a dict of Config values, got {type(case).__name__}")
+    config_keys = {f.name for f in dataclasses.fields(cls.Config)}
+    unknown = sorted(set(case) - config_keys)
+    assert not unknown, (
+        f"{name}.conformance_case has key(s) {unknown} that are not Config fields "
+        f"({sorted(config_keys)})")
+    assert all(hasattr(f, a) for f in fields for a in ("name", "components", "units",
+                                                       "long_name")), (
+        f"{name}.fields must be kit Field objects (name, components, units, long_name)")
+    try:
+        check_plugin_settings(cls(**copy.deepcopy({**case, **kwargs})))
+    except ValueError as exc:  # ConfigError is one
+        raise AssertionError(f"{name}.conformance_case fails the start-up checks: {exc}") from exc
+    _, cloud, ds = solve_conformance_case(cls, case, **kwargs)
+    check_physics_dataset(ds, fields, name, n_points=cloud.n_points)
 
 
 def check_study(cls: type, **kwargs: Any) -> None:

@@ -96,8 +96,7 @@ def support_constraints(model, layout, supports):
             raise ConfigError(f"physics.supports[{i}] needs where: a selector of the points "
                               "it holds, e.g. {boundary: true}.")
         sel = where if isinstance(where, Selector) else Selector(**dict(where))
-        mask = select(sel, model.points, model.boundary, model.curves)
-        nodes = np.flatnonzero(mask)
+        nodes = select(sel, model.points, model.boundary, model.curves)  # sorted indices
         value = s.get("value", 0.0)
         if isinstance(value, str):
             value = evaluate_values(value, model.points[nodes])[:, None]

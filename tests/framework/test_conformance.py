@@ -47,3 +47,108 @@ def test_the_suite_catches_a_broken_embedder():
 
     with pytest.raises(AssertionError, match="must store 'n_components' unchanged"):
         check_contract(NoStore)
+
+
+# -- the Dataset a physics' solve returns (pointatlas.physics_dataset_check) --
+
+def _laplace_beltrami():
+    from pointatlas.registry import load_plugin
+
+    return load_plugin("physics", "laplace_beltrami")
+
+
+@pytest.fixture(scope="module")
+def solved_case():
+    """(cloud, Dataset) of LaplaceBeltrami's conformance case: f = 1, u = 0 on the boundary."""
+    from pointatlas.physics_dataset_check import solve_conformance_case
+
+    cls = _laplace_beltrami()
+    _, cloud, ds = solve_conformance_case(cls, cls.conformance_case)
+    return cloud, ds
+
+
+def test_the_conformance_case_solves_to_a_dataset_that_passes(solved_case):
+    from pointatlas.physics_dataset_check import check_physics_dataset
+
+    cloud, ds = solved_case
+    assert cloud.n_points == 225 and ds.sizes["point"] == 225
+    u = ds["u"].values
+    # −Δu + u = 1 with u = 0 on the boundary: u vanishes on the whole boundary (the
+    # supports hold every boundary point, not a shifted set), and its maximum lies a little
+    # above the flat unit square's (Fourier series: 0.06981), the patch being curved
+    xy = cloud.points[:, :2]
+    edge = np.isclose(xy, 0.0, atol=1e-12).any(axis=1) | np.isclose(xy, 1.0, atol=1e-12).any(
+        axis=1)
+    assert edge.sum() == 56
+    assert np.abs(u[edge]).max() < 1e-8
+    assert 0.0698 < u.max() < 0.08
+    check_physics_dataset(ds, _laplace_beltrami().fields, "LaplaceBeltrami", cloud.n_points)
+
+
+def _drop_units(ds):
+    del ds["u"].attrs["units"]
+    return ds
+
+
+def _unnamed_dim(ds):
+    import xarray as xr
+
+    # no dims given: xarray names it dim_0
+    ds["residual_history"] = xr.DataArray(np.zeros(3), attrs={"long_name": "r", "units": "1"})
+    return ds
+
+
+@pytest.mark.parametrize("mutate,message", [
+    (_drop_units, r"without 'long_name'/'units' attrs: \['u'\]"),
+    (_unnamed_dim, r"variable 'residual_history' has unnamed dimension\(s\) \['dim_0'\]"),
+])
+def test_check_physics_fails_on_a_physics_whose_solve_breaks_the_schema(mutate, message):
+    base = _laplace_beltrami()
+
+    class BrokenPhysics(base):
+        def solve(self, ctx, *, cloud, atlas_settings):
+            return mutate(super().solve(ctx, cloud=cloud, atlas_settings=atlas_settings))
+
+    with pytest.raises(AssertionError, match=r"BrokenPhysics\.solve's Dataset: .*" + message):
+        check_plugin("physics", BrokenPhysics)
+
+
+def _set(name, value):
+    def mutate(ds):
+        ds[name] = value
+        return ds
+    return mutate
+
+
+def _empty_long_name(ds):
+    ds["u"].attrs["long_name"] = " "
+    return ds
+
+
+def _non_finite(ds):
+    ds["u"].values[7] = np.nan
+    return ds
+
+
+@pytest.mark.parametrize("mutate,message", [
+    (_empty_long_name, r"variable 'u' has long_name=' ': it must be a non-empty string"),
+    (_non_finite, r"variable 'u' has 1 non-finite value\(s\)"),
+    (lambda ds: ds.drop_vars("u"), r"declared field 'u' is missing: no data variable 'u'"),
+    (lambda ds: ds.drop_vars("point"), r"'point' is not a coordinate"),
+    (_set("u", ((), 1.0, {"long_name": "u", "units": "1"})),
+     r"declared field 'u' is missing: variable 'u' has dims \(\), without 'point'"),
+    (_set("u", (("point", "c"), np.zeros((225, 2)), {"long_name": "u", "units": "1"})),
+     r"field variable 'u' holds 2 value\(s\) per point; the declared field 'u' has 1"),
+])
+def test_the_dataset_check_names_the_variable_and_the_rule(solved_case, mutate, message):
+    from pointatlas.physics_dataset_check import check_physics_dataset
+
+    _, ds = solved_case
+    bad = mutate(ds.copy(deep=True))
+    with pytest.raises(AssertionError, match=r"^LaplaceBeltrami\.solve's Dataset: " + message):
+        check_physics_dataset(bad, _laplace_beltrami().fields, "LaplaceBeltrami", 225)
+
+
+def test_a_conformance_case_with_a_key_of_no_config_field_fails():
+    with pytest.raises(AssertionError, match=r"conformance_case has key\(s\) \['sources'\]"):
+        check_plugin("physics", _laplace_beltrami(), solve_case={"sources": "1"})

@@ -1,4 +1,5 @@
-"""External loads as nodal forces F_a = ∂(work)/∂U_a (Paper 1 §3, thesis L363–520).
+"""The shell's loads as external work on its displacement field (Paper 1 §3, thesis
+L363–520), assembled by the kit (:mod:`pointatlas_kit.external_work`: F = −∂Π_ext/∂U):
 
 * point force P at a surface point x: F_a = p_a(ξ) P, with (κ, ξ) the chart preimage of the
   closest-point projection of the given point (Paper 2 App. A);
@@ -7,6 +8,9 @@
 * pressure p along the unit normal: q = p n;
 * line force t per unit length on boundary points: trapezoidal lengths along the ordered
   boundary curve, F_a = Σ_i ℓ_i p_a(x_i) t.
+
+What is the shell's here: the refusals (a point load off the surface, a line load with no
+segment) and the geometry of where the load acts.
 """
 from __future__ import annotations
 
@@ -14,7 +18,17 @@ import numpy as np
 
 from pointatlas.errors import InputError
 
+from pointatlas_kit.external_work import chart_point_quadrature, load_vector, node_point_quadrature
+from pointatlas_kit.fields import FieldLayout
 from pointatlas_kit.selectors import describe, select
+
+from .displacement_field import DISPLACEMENT
+
+
+def _forces(quadrature, values) -> np.ndarray:
+    """(N, 3) nodal forces of ``values`` per unit measure on the displacement."""
+    return load_vector(FieldLayout((DISPLACEMENT,), quadrature.n_nodes), DISPLACEMENT.name,
+                       quadrature, values)
 
 
 def _vec(v) -> str:
@@ -31,7 +45,6 @@ def point_load(atlas, at, force, spacing: float, max_offset: float, points=None)
     to the nearest of ``points`` (default: the atlas's nodes; pass the sampled points so that
     ghosts are not proposed).
     """
-    from pointatlas_atlas.evaluation import basis_at
     from pointatlas_atlas.projection import closest_point
 
     x = np.asarray(at, dtype=np.float64).reshape(1, 3)
@@ -39,10 +52,9 @@ def point_load(atlas, at, force, spacing: float, max_offset: float, points=None)
     converged = bool(proj.converged[0]) and np.isfinite(proj.distance[0])
     allowed = max_offset * spacing
     if converged and float(proj.distance[0]) <= allowed:
-        basis = basis_at(atlas, proj.chart, proj.xi, order=0)
-        F = np.zeros((atlas.points_.shape[0], 3))
-        np.add.at(F, basis.indices, basis.values[:, None] * np.asarray(force, dtype=np.float64))
-        return F, proj.point[0], float(proj.distance[0])
+        q = chart_point_quadrature(atlas, proj.chart, proj.xi, np.ones(1))
+        return _forces(q, np.asarray(force, dtype=np.float64)), proj.point[0], \
+            float(proj.distance[0])
     if converged:
         dist, nearest = float(proj.distance[0]), proj.point[0]
         where = f"the nearest surface point is {_vec(nearest)}"
@@ -63,26 +75,21 @@ def point_load(atlas, at, force, spacing: float, max_offset: float, points=None)
 
 
 def surface_load(quadrature, n_nodes: int, force=None, pressure=None, normals=None):
-    """Consistent nodal forces of a load per unit area (vector ``force`` or ``pressure``·n)."""
-    q = quadrature
-    counts = np.diff(q.indptr)
-    rows = np.repeat(np.arange(len(q.weights)), counts)
+    """Consistent nodal forces (n_nodes, 3) of a load per unit area (vector ``force`` or
+    ``pressure``·n with ``normals`` (m, 3) at the quadrature points)."""
+    if quadrature.n_nodes != n_nodes:
+        raise InputError(f"surface_load: the quadrature has {quadrature.n_nodes} nodes, "
+                         f"not {n_nodes}.")
     if pressure is not None:
-        traction = float(pressure) * normals
+        traction = float(pressure) * np.asarray(normals, dtype=np.float64)
     else:
-        traction = np.broadcast_to(np.asarray(force, dtype=np.float64), (len(q.weights), 3))
-    w = q.basis[:, 0] * q.weights[rows]
-    F = np.zeros((n_nodes, 3))
-    for j in range(3):
-        F[:, j] = np.bincount(q.indices, weights=w * traction[rows, j], minlength=n_nodes)
-    return F
+        traction = np.asarray(force, dtype=np.float64)
+    return _forces(quadrature, traction)
 
 
 def line_load(atlas, points, boundary, curves, where, force, spacing: float):
     """Nodal forces of a force per unit length on the boundary points ``where`` selects
     (``spacing``: median point spacing; longer steps along a curve are not segments)."""
-    from pointatlas_atlas.evaluation import basis_at_nodes
-
     nodes = select(where, points, boundary, curves)
     from pointatlas_atlas.boundary import curve_segments
 
@@ -97,12 +104,5 @@ def line_load(atlas, points, boundary, curves, where, force, spacing: float):
         raise InputError(f"the line load on {describe(where)} selects {len(nodes)} boundary "
                          "point(s) but no boundary segment between them: select a stretch of "
                          "a boundary curve (at least two neighbouring boundary points).")
-    basis, _, _ = basis_at_nodes(atlas, nodes, order=0)
-    counts = np.diff(basis.indptr)
-    w = basis.values * np.repeat(length[nodes], counts)
-    F = np.zeros((atlas.points_.shape[0], 3))
-    t = np.asarray(force, dtype=np.float64)
-    for j in range(3):
-        F[:, j] = np.bincount(basis.indices, weights=w * t[j], minlength=F.shape[0])
-    return F
-
+    q = node_point_quadrature(atlas, nodes, length[nodes])
+    return _forces(q, np.asarray(force, dtype=np.float64))

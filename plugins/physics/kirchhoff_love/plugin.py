@@ -25,6 +25,11 @@ class KirchhoffLove:
     description: ClassVar[str] = (
         "Kirchhoff–Love thin shell on the atlas: linear analysis with supports by augmented "
         "Lagrangian, ghost nodes at boundaries (thesis §4, Papers 1–2).")
+    #: Config values of a small problem for pointatlas.testing.check_physics: clamped on the
+    #: whole boundary of its open patch (in [0, 1]² × [0, 0.35]) under a surface load
+    conformance_case: ClassVar[dict] = {
+        "supports": [{"kind": "clamped", "where": {"box": [-1.0, -1.0, -1.0, 2.0, 2.0, 2.0]}}],
+        "loads": [{"kind": "surface", "force": [0.0, 0.0, -1.0]}]}
 
     def energies(self, positions=None) -> list:
         """The shell's kit energies: membrane + bending (:class:`.shell_energy.ShellEnergy`)."""

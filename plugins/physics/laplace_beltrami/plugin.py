@@ -74,6 +74,10 @@ class LaplaceBeltrami(LinearPhysics):
     Config = LaplaceBeltramiConfig
     fields: ClassVar[tuple] = (U,)
     description: ClassVar[str] = "−Δ_Γ u + c u = f on the atlas (the physics kit's scalar PDE)."
+    #: Config values of a small problem for pointatlas.testing.check_physics (f = 1, u = 0 on
+    #: the whole boundary of its open patch, which lies in [0, 1]² × [0, 0.35])
+    conformance_case: ClassVar[dict] = {"c": 1.0, "source_term": "1", "supports": [
+        {"where": {"box": [-1.0, -1.0, -1.0, 2.0, 2.0, 2.0]}, "value": 0.0}]}
 
     def energies(self, positions):
         from pointatlas_kit.energy import LinearSource

@@ -151,8 +151,12 @@ class LinearPhysics:
 
     def solve(self, ctx, *, cloud, atlas_settings):
         """Solve on ``cloud``; returns the fields at the points (xr.Dataset)."""
+        from pointatlas_solvers.linear_backends import resolve_backend
+
         self.solution_ = solve_linear_problem(self, ctx, cloud, atlas_settings)
-        return self.solution_.dataset()
+        ds = self.solution_.dataset()
+        ds.attrs["linear_solver"] = resolve_backend(self.solver)  # 'auto' resolved
+        return ds
 
     def evaluate(self, name: str, x) -> np.ndarray:
         return self._solved().evaluate(name, x)

@@ -187,6 +187,7 @@ class ShellNonlinearStudy:
                 ctx.log.error("%s", exc)
         ds = self._dataset(model, records, values, names)
         ds.attrs["stopped"] = stopped or "completed the load path"
+        ds.attrs["linear_solver"] = model.linear_solver
         warning = model.warning()  # failed patches, kept by the user's choice
         if warning:
             ds.attrs["warnings"] = warning

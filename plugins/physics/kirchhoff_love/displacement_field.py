@@ -2,5 +2,5 @@
 from pointatlas_kit.fields import Field
 
 #: 3 Cartesian components, chart derivatives to order 2; the energy uses derivatives only
-DISPLACEMENT = Field("displacement", components=3, order=2, value=False, units="m",
+DISPLACEMENT = Field("displacement", components=3, order=2, value=False, units="length",
                      long_name="displacement of the middle surface")

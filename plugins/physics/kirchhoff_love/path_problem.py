@@ -25,6 +25,10 @@ class ShellPath:
         self.n_nodes = model.nodes.shape[0]
         self.n_constraint_rows = constraints.matrix.shape[0]
         self.has_loads = bool(np.any(F))
+        from pointatlas_solvers.linear_backends import resolve_backend
+
+        #: the linear-solver backend the path's solves use (``auto`` resolved)
+        self.linear_solver = resolve_backend(settings.solver)
         #: (support index, imposed displacement (3,)) of the 'displacement' supports
         self.imposed = [(k, np.asarray(sup.value, float)) for k, sup in
                         enumerate(settings.supports) if sup.kind == "displacement"]

@@ -98,6 +98,9 @@ class KirchhoffLove:
         # the side the normals (and pressures) of the atlas face: 'outward', the user's
         # atlas.orientation '[nx, ny, nz]', 'first_chart' (not fixed) or 'none'
         ds.attrs["normal_orientation"] = str(model.atlas.orientation_)
+        from pointatlas_solvers.linear_backends import resolve_backend
+
+        ds.attrs["linear_solver"] = resolve_backend(s.solver)  # 'auto' resolved
         return ds
 
     # -- what studies ask of a solved or built shell (the protocol; no study reads model_) --

@@ -89,7 +89,7 @@ class ShellSettings:
     loads: List[Load] = field(default_factory=list)
     segment_points: int = 4          # Gauss points per boundary segment (0: collocate)
     ghost_layers: int = 2            # ghost node layers beyond the boundary (Paper 1 §4.1.2)
-    solver: str = "direct"           # sparse direct (SuperLU) or CG with incomplete LU
+    solver: str = "auto"             # pointatlas_solvers backend: auto = PARDISO if installed, else SuperLU
     penalty: float = 1.0e6           # augmented-Lagrangian penalty, relative to diag(K)
     constraint_tol: float = 1.0e-10  # relative constraint violation to stop the AL loop
     max_load_offset: float = 0.5     # a point load may lie this many spacings off the surface

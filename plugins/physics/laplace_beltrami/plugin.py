@@ -29,7 +29,7 @@ class LaplaceBeltramiConfig:
     source_term: str = "0"
     supports: List[Any] = field(default_factory=list)
     ghost_layers: int = 2
-    solver: str = "superlu"
+    solver: str = "auto"
     penalty: float = 1.0e6
     constraint_tol: float = 1.0e-12
     parameter_constraints: ClassVar[dict] = {

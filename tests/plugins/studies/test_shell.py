@@ -22,6 +22,10 @@ def test_plate_run_writes_results_vtp_and_report(tmp_path, run_cli):
     assert ds["displacement"].attrs["reference"] == pytest.approx(1.2257045)
     assert float(ds["relative_error"]) < 0.01  # 0.2 % at this size (thesis value)
     assert list(ds["reference"].values)[0].startswith("thesis")
+    from pointatlas_solvers.linear_backends import resolve_backend
+
+    # the default solver 'auto' is PARDISO when pypardiso is installed, and the run says so
+    assert ds.attrs["linear_solver"] == resolve_backend("auto")
     assert ds["displacement_field"].dims == ("point", "dim")
     assert (run_dir / "shell.vtp").stat().st_size > 0
     r = run_cli("pointatlas-report", str(run_dir), cwd=tmp_path)

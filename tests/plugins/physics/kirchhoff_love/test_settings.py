@@ -44,7 +44,7 @@ def test_valid_settings_pass():
     (dict(loads=[Load(kind="line", force=[0, 0, 1])]), "needs where"),
     (dict(solver="magic"), r"^physics\.solver='magic' is invalid: it must be one of 'direct', "
                            r"'cg_ilu', 'superlu', 'pardiso', 'cg_amg', 'auto'\. Pass e\.g\. "
-                           r"physics\.solver=direct\.$"),
+                           r"physics\.solver=auto\.$"),
 ])
 def test_invalid_settings_are_named(kw, match):
     with pytest.raises(ConfigError, match=match):

@@ -155,7 +155,8 @@ class Atlas:
             margin=s.margin_for(chart_dim), keep_basis=keep_basis)
 
     def partition(self, points: np.ndarray, markers: Optional[np.ndarray] = None, *,
-                  keep_basis: bool = False) -> np.ndarray:
+                  keep_basis: bool = False, extra_bytes: int = 0,
+                  extra_what: str = "") -> np.ndarray:
         """Partition the markers (default: the points) and fit the PU. Returns labels (M,).
 
         First refuses (InputError) an atlas whose estimated memory does not fit the memory
@@ -170,7 +171,8 @@ class Atlas:
                              "with the same D.")
         # the chart dimension d, for d-dependent defaults (the embedders' n_components)
         self.chart_dim_ = int(getattr(self.make_embedder(), "n_components", 2))
-        self._check_memory(P.shape[0], Q.shape[0], P.shape[1], keep_basis)
+        self._check_memory(P.shape[0], Q.shape[0], P.shape[1], keep_basis, extra_bytes,
+                           extra_what)
         self.points_, self.markers_ = P, Q
         self.point_tree_ = cKDTree(P)
         self._control_sets, self._embeddings, self._margin_csr = {}, {}, None
@@ -213,16 +215,18 @@ class Atlas:
             s.max_refinement_depth, refuse=refuse)
 
     def _check_memory(self, n_points: int, n_markers: int, ambient_dim: int,
-                      keep_basis: bool) -> None:
-        """Refuse, before any work, an atlas that cannot fit in memory (one line, with fix)."""
+                      keep_basis: bool, extra_bytes: int = 0, extra_what: str = "") -> None:
+        """Refuse, before any work, an atlas (with ``extra_bytes`` of what is computed on it,
+        e.g. a physics' tangent) that cannot fit in memory (one line, with fix)."""
         needed = self.estimated_bytes(n_points, n_markers, ambient_dim, self.chart_dim_,
-                                      keep_basis)
+                                      keep_basis) + int(extra_bytes)
         available, _ = mem.available_memory_bytes()
         # the estimate is linear in N; the suggested size leaves 10 % of the memory free
         fitting = max(1, int(n_points * min(1.0, available / max(needed, 1)) * 0.9))
         mem.check_memory(
             needed, f"an atlas of {n_points} points in R^{ambient_dim} (charts of dimension "
-                    f"{self.chart_dim_}, quadrature order {self.settings.quadrature_order})",
+                    f"{self.chart_dim_}, quadrature order {self.settings.quadrature_order})"
+                    + (f" with {extra_what}" if extra_what else ""),
             f"Use fewer points (e.g. source.n_points={fitting}, memory grows in proportion), a "
             "lower study.quadrature_order, or a machine with more memory.")
 

@@ -100,6 +100,21 @@ def estimate_atlas_bytes(n_points: int, ambient_dim: int, intrinsic_dim: int,
     return int(words * WORD)
 
 
+#: copies of the tangent's entries alive at once in a linear solve: the assembled blocks,
+#: their CSR form, K + ρCᵀC and about one more for the sparse factor (measured on the
+#: hemisphere shell, 2 000 and 4 000 points: tests/plugins/atlas/test_memory_estimate.py)
+TANGENT_COPIES = 4
+
+
+def estimate_tangent_bytes(n_nodes: int, block: int, support_size: float,
+                           copies: int = TANGENT_COPIES) -> int:
+    """Bytes of a physics' sparse tangent and its solve on ``n_nodes`` atlas nodes with
+    ``block`` DOFs each: two nodes couple when their supports (radius r, ``support_size``
+    s = π r² nodes on a surface) overlap, so about 4 s neighbours a node; each coupling is a
+    block × block set of entries of 12 bytes (value and column index), ``copies`` times."""
+    return int(n_nodes * 4.0 * support_size * block * block * 12 * copies)
+
+
 def estimate_dense_embedding_bytes(n_points: int) -> int:
     """Bytes of an embedding through an N x N matrix (Isomap's geodesic distances, classical
     MDS in place): 8 N²."""

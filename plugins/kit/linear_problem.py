@@ -123,7 +123,8 @@ def solve_linear_problem(physics, ctx, cloud, atlas_settings) -> LinearSolution:
     order = max(f.order for f in physics.fields)
     model = build_surface_model(cloud, atlas_settings, **atlas_factories(ctx, atlas_settings,
                                                                          name),
-                                order=order, ghost_layers=physics.ghost_layers, log=ctx.log)
+                                order=order, ghost_layers=physics.ghost_layers,
+                                block=sum(f.components for f in physics.fields), log=ctx.log)
     layout = FieldLayout(physics.fields, model.nodes.shape[0])
     A = Assembler(model.quadrature, layout, physics.energies(model.quadrature.positions))
     zero = np.zeros(layout.n_dofs)

@@ -115,8 +115,13 @@ def check_surface_cloud(cloud, n_neighbors: int) -> None:
 
 
 def build_surface_model(cloud, atlas_settings, make_embedder, make_lme, make_pu, *,
-                        order: int, ghost_layers: int = 2, log=None) -> SurfaceModel:
-    """Boundary, ghosts, atlas and quadrature (basis to chart derivative ``order``)."""
+                        order: int, ghost_layers: int = 2, block: int = 1,
+                        log=None) -> SurfaceModel:
+    """Boundary, ghosts, atlas and quadrature (basis to chart derivative ``order``).
+
+    Refuses before any work a model that cannot fit in memory: the atlas with its basis
+    plus the tangent of ``block`` DOFs per node and its solve
+    (:func:`pointatlas_atlas.memory_estimate.estimate_tangent_bytes`)."""
     import time
 
     from pointatlas_atlas.atlas import Atlas
@@ -142,7 +147,13 @@ def build_surface_model(cloud, atlas_settings, make_embedder, make_lme, make_pu,
     markers = cloud.markers if cloud.markers is not None else P
     t1 = time.perf_counter()
     atlas = Atlas(atlas_settings, make_embedder, make_lme, make_pu)
-    atlas.partition(nodes, markers, keep_basis=True)  # AtlasError: charts fail after repair
+    from pointatlas_atlas.memory_estimate import estimate_tangent_bytes, support_size
+
+    s = atlas_settings
+    tangent = estimate_tangent_bytes(nodes.shape[0], block,
+                                     support_size(2, s.gamma_lme, s.tol_lme))
+    atlas.partition(nodes, markers, keep_basis=True, extra_bytes=tangent,  # AtlasError:
+                    extra_what=f"a tangent of {block} DOF per node")     # charts fail
     warning = atlas.refinement_warning()  # only with atlas.allow_failed_patches=true
     if warning and log is not None:
         log.warning(warning)
@@ -150,7 +161,7 @@ def build_surface_model(cloud, atlas_settings, make_embedder, make_lme, make_pu,
     atlas.build_charts()
     t3 = time.perf_counter()
     atlas.build_quadrature(real=real, keep_basis=True, need_second=order >= 2)
-    quadrature = atlas_quadrature(atlas, order)
+    quadrature = atlas_quadrature(atlas, order, release_basis=True)
     t4 = time.perf_counter()
     times.update(boundary=t1 - t0, partition=t2 - t1, charts=t3 - t2, quadrature=t4 - t3)
     touched = np.zeros(nodes.shape[0], bool)

@@ -56,7 +56,7 @@ def build_model(cloud, settings, atlas_settings, make_embedder, make_lme, make_p
                              poisson_ratio=settings.poisson_ratio, thickness=settings.thickness)
     material.check()
     m = build_surface_model(cloud, atlas_settings, make_embedder, make_lme, make_pu, order=2,
-                            ghost_layers=settings.ghost_layers, log=log)
+                            ghost_layers=settings.ghost_layers, block=3, log=log)
     return ShellModel(m.points, m.nodes, m.boundary, m.curves, m.spacing, m.atlas,
                       m.quadrature, m.times, material=material)
 

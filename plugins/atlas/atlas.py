@@ -233,9 +233,10 @@ class Atlas:
     def refinement_warning(self) -> Optional[str]:
         """Why the atlas may be wrong, if patches still fail the chart test after the repair
         of :meth:`partition` (only with ``allow_failed_patches``: else it refused); else None."""
-        if self.accepted_.all():
-            return None
-        return self._failed_patches_message(refuse=False)
+        kept = list(getattr(self, "kept_defects_", []))  # e.g. creases, atlas.allow_creases
+        if not self.accepted_.all():
+            kept.append(self._failed_patches_message(refuse=False))
+        return "; ".join(kept) or None
 
     def build_charts(self, progress=lambda it, **kw: it) -> list[Chart]:
         """One chart per patch (after :meth:`partition`). With least_squares_fit, the control

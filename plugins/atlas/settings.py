@@ -56,6 +56,8 @@ class AtlasSettings:
     allow_failed_patches: bool = False    # patches failing the chart test after repair
     #                                       (re-embedding, splitting; chart_repair.py): False
     #                                       refuses the atlas, True keeps them, flagged
+    allow_creases: bool = False           # crease points of the cloud check (a physics):
+    #                                       False refuses, True runs on, flagged in warnings
     orientation: Optional[List[float]] = None  # the side an open surface's normals face
     #                                       (n·e > 0 on average; orientation.py); None: the
     #                                       first chart's. Closed surfaces: always outward
@@ -76,7 +78,7 @@ class AtlasSettings:
         "max_stress": _POSITIVE,
         "max_distortion": [Interval(float, 1, None, closed="neither")],  # a singular-value ratio
         "max_refinement_depth": [Interval(int, 0, None)],
-        "allow_failed_patches": [Types(bool)],
+        "allow_failed_patches": [Types(bool)], "allow_creases": [Types(bool)],
         "orientation": [Each(Interval(float)), None],          # non-zero: checked in check()
     }
 

@@ -91,17 +91,28 @@ def atlas_factories(ctx, atlas_settings, physics: str | None = None, **chart_opt
                                  outside="flag"))
 
 
-def check_surface_cloud(cloud, n_neighbors: int) -> None:
+def check_surface_cloud(cloud, n_neighbors: int, allow_creases: bool = False) -> str | None:
     """Refuse (InputError, one line with where and the fix) a cloud a physics on one smooth
     surface cannot carry: creases or non-disc neighbourhoods
     (:mod:`pointatlas_atlas.cloud_checks`), isolated points, or several components (a
-    physics is solved on one connected surface; give each component its own run)."""
+    physics is solved on one connected surface; give each component its own run).
+
+    With ``allow_creases`` a cloud whose only defect is crease points (e.g. fillets sampled
+    at about one spacing per curvature radius) is kept: the reason is returned as the
+    warning the results carry."""
     from pointatlas_atlas.cloud_checks import check_cloud, components_message, refusal, where
 
     check = check_cloud(cloud.points, n_neighbors)
     reason = refusal(cloud.points, check)
+    kept = None
     if reason:
-        raise InputError(f"{cloud.name}: {reason}")
+        only_creases = (check.crease.any() and not check.nonmanifold.any()
+                        and reason.startswith("this cloud has creases"))
+        if not (allow_creases and only_creases):
+            extra = (" To run anyway with the results flagged as not trustworthy there, "
+                     "set atlas.allow_creases=true." if only_creases else "")
+            raise InputError(f"{cloud.name}: {reason}{extra}")
+        kept = f"{cloud.name}: kept by atlas.allow_creases=true, but {reason}"
     comp = check.components
     if len(comp.sizes) > 1:
         raise InputError(f"{cloud.name}: {components_message(comp)}; a physics is solved on "
@@ -112,6 +123,7 @@ def check_surface_cloud(cloud, n_neighbors: int) -> None:
         raise InputError(f"{cloud.name}: {comp.n_isolated} isolated point(s), far from the "
                          f"surface, e.g. near {where(cloud.points[iso])}: remove them (they "
                          "would carry nodes of no chart).")
+    return kept
 
 
 def build_surface_model(cloud, atlas_settings, make_embedder, make_lme, make_pu, *,
@@ -137,7 +149,8 @@ def build_surface_model(cloud, atlas_settings, make_embedder, make_lme, make_pu,
                          f"D = {P.shape[1]}.")
     spacing = float(np.median(cKDTree(P).query(P, k=2)[0][:, 1]))
     t0 = time.perf_counter()
-    check_surface_cloud(cloud, atlas_settings.graph_neighbors)
+    kept = check_surface_cloud(cloud, atlas_settings.graph_neighbors,
+                               getattr(atlas_settings, "allow_creases", False))
     boundary = boundary_mask(P)
     curves = boundary_curves(P, boundary) if boundary.any() else []
     G = (ghost_points(P, boundary, layers=ghost_layers)
@@ -147,6 +160,7 @@ def build_surface_model(cloud, atlas_settings, make_embedder, make_lme, make_pu,
     markers = cloud.markers if cloud.markers is not None else P
     t1 = time.perf_counter()
     atlas = Atlas(atlas_settings, make_embedder, make_lme, make_pu)
+    atlas.kept_defects_ = [kept] if kept else []
     from pointatlas_atlas.memory_estimate import estimate_tangent_bytes, support_size
 
     s = atlas_settings

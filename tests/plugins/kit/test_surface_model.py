@@ -39,8 +39,13 @@ def test_a_physics_refuses_creases_and_several_components():
     from ..atlas.test_cloud_checks import cube_surface
 
     check_surface_cloud(PointCloud(points=_sphere(800), name="sphere"), 10)  # smooth: passes
-    with pytest.raises(InputError, match="creases"):
-        check_surface_cloud(PointCloud(points=cube_surface(14), name="cube"), 10)
+    cube = PointCloud(points=cube_surface(14), name="cube")
+    with pytest.raises(InputError, match="creases.*set atlas.allow_creases=true"):
+        check_surface_cloud(cube, 10)
+    # kept on request: the reason comes back as the warning the results carry
+    kept = check_surface_cloud(cube, 10, allow_creases=True)
+    assert kept.startswith("cube: kept by atlas.allow_creases=true, but this cloud has creases")
+    assert check_surface_cloud(PointCloud(points=_sphere(800), name="sphere"), 10, True) is None
     two = np.vstack([_sphere(600), _sphere(600, (5.0, 0.0, 0.0))])
     with pytest.raises(InputError, match="2 connected components.*one connected surface"):
-        check_surface_cloud(PointCloud(points=two, name="two spheres"), 10)
+        check_surface_cloud(PointCloud(points=two, name="two spheres"), 10, allow_creases=True)

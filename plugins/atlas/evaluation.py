@@ -58,7 +58,7 @@ def basis_at(atlas, chart: np.ndarray, xi: np.ndarray, order: int = 1) -> BasisF
                              "evaluate at points inside the sampled surface.")
         parts.append(b.renumbered(c.node_index))
         rows.append(sel)
-    return _stack(parts, np.concatenate(rows))
+    return stack_rows(parts, np.concatenate(rows))
 
 
 def basis_at_nodes(atlas, nodes: np.ndarray, order: int = 1):
@@ -69,7 +69,7 @@ def basis_at_nodes(atlas, nodes: np.ndarray, order: int = 1):
     return basis_at(atlas, chart, xi, order), chart, xi
 
 
-def _stack(parts: list[BasisFunctions], rows: np.ndarray) -> BasisFunctions:
+def stack_rows(parts: list[BasisFunctions], rows: np.ndarray) -> BasisFunctions:
     """Concatenate row blocks, then put rows back in the order given by ``rows``."""
     counts = np.concatenate([np.diff(p.indptr) for p in parts])
     indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)

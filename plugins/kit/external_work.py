@@ -42,10 +42,10 @@ def chart_point_quadrature(atlas, chart, xi, weights) -> AtlasQuadrature:
     if not (len(chart) == len(xi) == len(weights)):
         raise InputError(f"chart_point_quadrature: {len(chart)} charts, {len(xi)} points "
                          f"and {len(weights)} weights; give one of each per point.")
-    k_pts = len(chart)
-    counts = np.zeros(k_pts, np.int64)
-    cols, vals = [None] * k_pts, [None] * k_pts
-    X, T = np.zeros((k_pts, 3)), np.zeros((k_pts, 2, 3))
+    from pointatlas_atlas.evaluation import stack_rows
+
+    X, T = np.zeros((len(chart), 3)), np.zeros((len(chart), 2, 3))
+    parts, rows = [], []
     for k in np.unique(chart):
         sel = np.flatnonzero(chart == k)
         c = atlas.charts_[k]
@@ -55,19 +55,17 @@ def chart_point_quadrature(atlas, chart, xi, weights) -> AtlasQuadrature:
             raise InputError(f"load point {i} (ξ = {xi[i].tolist()}) lies outside chart "
                              f"{k}'s domain; a load must act on the sampled surface.")
         X[sel], T[sel], _ = chart_derivatives(b, c.control_points, 1)
-        node = np.asarray(c.node_index, np.int64)
-        for j, i in enumerate(sel):
-            lo, hi = b.indptr[j], b.indptr[j + 1]
-            cols[i], vals[i], counts[i] = node[b.indices[lo:hi]], b.values[lo:hi], hi - lo
-    indptr = np.concatenate([[0], np.cumsum(counts)])
-    empty = np.zeros(0)
+        parts.append(b.renumbered(c.node_index))
+        rows.append(sel)
+    if not parts:
+        raise InputError("chart_point_quadrature: no point given.")
+    basis = stack_rows(parts, np.concatenate(rows))   # rows back in the input order
     signs = np.asarray(getattr(atlas, "chart_orientation_", np.ones(len(atlas.charts_))),
                        float)
     return AtlasQuadrature(
-        indptr=indptr, indices=np.concatenate(cols) if k_pts else empty.astype(np.int64),
-        basis=(np.concatenate(vals) if k_pts else empty)[:, None], weights=weights,
-        chart=chart, positions=X, tangents=T, second=None, orientation=signs[chart],
-        n_nodes=atlas.points_.shape[0])
+        indptr=basis.indptr, indices=basis.indices, basis=basis.values[:, None],
+        weights=weights, chart=chart, positions=X, tangents=T, second=None,
+        orientation=signs[chart], n_nodes=atlas.points_.shape[0])
 
 
 def node_point_quadrature(atlas, nodes, weights) -> AtlasQuadrature:

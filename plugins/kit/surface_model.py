@@ -12,7 +12,7 @@ with the atlas settings' γ and tolerance; :func:`atlas_factories` builds them.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -106,8 +106,9 @@ def check_surface_cloud(cloud, n_neighbors: int, allow_creases: bool = False) ->
     reason = refusal(cloud.points, check)
     kept = None
     if reason:
-        only_creases = (check.crease.any() and not check.nonmanifold.any()
-                        and reason.startswith("this cloud has creases"))
+        # creases are the only defect: the cloud passes once they are not counted
+        only_creases = check.crease.any() and refusal(cloud.points, replace(
+            check, crease=np.zeros_like(check.crease))) is None
         if not (allow_creases and only_creases):
             extra = (" To run anyway with the results flagged as not trustworthy there, "
                      "set atlas.allow_creases=true." if only_creases else "")

@@ -300,6 +300,28 @@ def refusal(points: np.ndarray, check: CloudCheck) -> str | None:
     return defects_message(np.asarray(points), check.crease, check.nonmanifold, comp.h)
 
 
+def verdict(points: np.ndarray, check: CloudCheck, allow_creases: bool = False
+            ) -> tuple[str | None, str | None]:
+    """(refusal, kept): the one-line reason to refuse the cloud (None if it may run) and,
+    when ``allow_creases`` keeps a cloud whose only defect is crease points, the reason the
+    results must carry as a warning (else None).
+
+    A refusal caused by creases alone names ``atlas.allow_creases``: with it, the run goes on
+    and its results are flagged (status completed_with_warnings), never presented as clean.
+    """
+    reason = refusal(points, check)
+    if not reason:
+        return None, None
+    only_creases = bool(check.crease.any()) and refusal(points, CloudCheck(
+        check.components, np.zeros_like(check.crease), check.nonmanifold)) is None
+    if allow_creases and only_creases:
+        return None, f"kept by atlas.allow_creases=true, but {reason}"
+    if only_creases:
+        reason += (" To run anyway with the results flagged as not trustworthy there, set "
+                   "atlas.allow_creases=true.")
+    return reason, None
+
+
 #: coefficient of variation of the nearest-neighbour distance above which a cloud is irregular
 #: for curvature on LME charts: quasi-uniform samples measure 0.004 (structured torus), 0.014
 #: (Fibonacci sphere), 0.12 (connected_pipes); uniformly random ones 0.53-0.54 and pyvista's

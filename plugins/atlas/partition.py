@@ -126,6 +126,16 @@ def refine_partition(labels: np.ndarray, adjacency: csr_matrix,
             np.array([depth for _, _, depth in final], dtype=np.int64))
 
 
+#: adjacent triangles whose image normals n_t·n_s fall below this are a fold. Where ξ folds
+#: over a smooth surface, the two triangles across the fold line lie in almost the same plane
+#: but face opposite ways (n_t·n_s ≈ −1: measured −0.95 to −1.0 on folded patches of the
+#: Stanford bunny). A valid chart across a crease of angle φ (a graph over its bisector plane)
+#: has triangles straddling it whose normals are up to φ apart: on the bunny's base rim,
+#: n_t·n_s down to −0.27 (~105°) on charts that do not fold, which n_t·n_s < 0 took for folds.
+#: −0.5 (120°) lies between; the cloud check calls creases sharper than 140° knife edges.
+FOLD_COSINE = -0.5
+
+
 def embedding_defects(points: np.ndarray, xi: np.ndarray, n_neighbors: int = 8
                       ) -> dict[str, float]:
     """How far an embedding ξ (n, d) of points (n, D) is from a good chart.
@@ -133,7 +143,8 @@ def embedding_defects(points: np.ndarray, xi: np.ndarray, n_neighbors: int = 8
     - ``stress``: Σ_edges (|ξ_a − ξ_b| − |P_a − P_b|)² / Σ_edges |P_a − P_b|² over the k-NN
       edges (a normalised version of the stress E_S of thesis Appendix E.1);
     - ``flip_fraction``: fraction of pairs of adjacent Delaunay triangles of ξ whose images
-      in R^3 (vertices ordered counter-clockwise in ξ) have opposite normals: a fold;
+      in R^3 (vertices ordered counter-clockwise in ξ) have opposite normals (more than 120°
+      apart, :data:`FOLD_COSINE`): a fold;
     - ``max_distortion`` / ``distortion``: largest / 95th-percentile ratio of singular values of
       the affine map ξ → P over the non-sliver triangles (edges < 3 median k-NN distances).
 
@@ -172,7 +183,7 @@ def embedding_defects(points: np.ndarray, xi: np.ndarray, n_neighbors: int = 8
     pair = (s_idx > t_idx) & good[t_idx] & good[np.maximum(s_idx, 0)]
     if pair.any():
         ta, sa = t_idx[pair], s_idx[pair]
-        out["flip_fraction"] = float(np.mean(np.sum(normal[ta] * normal[sa], 1) < 0))
+        out["flip_fraction"] = float(np.mean(np.sum(normal[ta] * normal[sa], 1) < FOLD_COSINE))
     else:
         out["flip_fraction"] = 0.0
     # affine map ξ → P on each good triangle: P_e = F ξ_e with F (3, 2)

@@ -12,7 +12,7 @@ with the atlas settings' γ and tolerance; :func:`atlas_factories` builds them.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -100,20 +100,13 @@ def check_surface_cloud(cloud, n_neighbors: int, allow_creases: bool = False) ->
     With ``allow_creases`` a cloud whose only defect is crease points (e.g. fillets sampled
     at about one spacing per curvature radius) is kept: the reason is returned as the
     warning the results carry."""
-    from pointatlas_atlas.cloud_checks import check_cloud, components_message, refusal, where
+    from pointatlas_atlas.cloud_checks import check_cloud, components_message, verdict, where
 
     check = check_cloud(cloud.points, n_neighbors)
-    reason = refusal(cloud.points, check)
-    kept = None
+    reason, kept = verdict(cloud.points, check, allow_creases)
     if reason:
-        # creases are the only defect: the cloud passes once they are not counted
-        only_creases = check.crease.any() and refusal(cloud.points, replace(
-            check, crease=np.zeros_like(check.crease))) is None
-        if not (allow_creases and only_creases):
-            extra = (" To run anyway with the results flagged as not trustworthy there, "
-                     "set atlas.allow_creases=true." if only_creases else "")
-            raise InputError(f"{cloud.name}: {reason}{extra}")
-        kept = f"{cloud.name}: kept by atlas.allow_creases=true, but {reason}"
+        raise InputError(f"{cloud.name}: {reason}")
+    kept = f"{cloud.name}: {kept}" if kept else None
     comp = check.components
     if len(comp.sizes) > 1:
         raise InputError(f"{cloud.name}: {components_message(comp)}; a physics is solved on "

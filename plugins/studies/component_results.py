@@ -18,24 +18,29 @@ PER_COMPONENT = ("area", "willmore_energy", "total_gaussian_curvature", "n_point
                  "n_patches", "n_unaccepted_patches")
 
 
-def checked_components(cloud: PointCloud, n_neighbors: int, log=None):
-    """The connected components of a surface cloud in R³ as clouds, largest first, and the
-    :class:`~pointatlas_atlas.cloud_checks.Components` (None if the cloud is not a surface
-    in R³: then ``[cloud]``, unchecked).
+def checked_components(cloud: PointCloud, n_neighbors: int, log=None,
+                       allow_creases: bool = False):
+    """(parts, components, kept): the connected components of a surface cloud in R³ as
+    clouds, largest first, the :class:`~pointatlas_atlas.cloud_checks.Components` (None if
+    the cloud is not a surface in R³: then ``[cloud]``, unchecked), and the warning the
+    results must carry if ``allow_creases`` kept a creased cloud (else None).
 
-    Raises InputError (one line, with where and the fix) for creases, non-disc
-    neighbourhoods or a cloud too unevenly sampled. Isolated points are dropped (counted in
+    Raises InputError (one line, with where and the fix) for creases (unless
+    ``allow_creases``), non-disc neighbourhoods or a cloud too unevenly sampled. Isolated points are dropped (counted in
     ``Components.n_isolated``, logged); markers follow the component of their nearest point.
     """
-    from pointatlas_atlas.cloud_checks import check_cloud, components_message, refusal
+    from pointatlas_atlas.cloud_checks import check_cloud, components_message, verdict
     from scipy.spatial import cKDTree
 
     if cloud.ambient_dim != 3 or cloud.intrinsic_dim not in (None, 2):
-        return [cloud], None
+        return [cloud], None, None
     check = check_cloud(cloud.points, n_neighbors)
-    reason = refusal(cloud.points, check)
+    reason, kept = verdict(cloud.points, check, allow_creases)
     if reason:
         raise InputError(f"{cloud.name}: {reason}")
+    kept = f"{cloud.name}: {kept}" if kept else None
+    if log is not None and kept:
+        log.warning("%s", kept)
     comp = check.components
     if log is not None and comp.n_isolated:
         log.warning("%s: %d isolated points dropped (groups of fewer than the minimum, far "
@@ -43,7 +48,7 @@ def checked_components(cloud: PointCloud, n_neighbors: int, log=None):
     if log is not None and len(comp.sizes) > 1:
         log.info("%s: %s; one atlas each", cloud.name, components_message(comp))
     if len(comp.sizes) == 1 and not comp.n_isolated:
-        return [cloud], comp
+        return [cloud], comp, kept
     marker_label = None
     if cloud.markers is not None:
         marker_label = comp.labels[cKDTree(cloud.points).query(cloud.markers)[1]]
@@ -57,7 +62,7 @@ def checked_components(cloud: PointCloud, n_neighbors: int, log=None):
             parameters=None if cloud.parameters is None else cloud.parameters[keep],
             name=cloud.name if len(comp.sizes) == 1 else f"{cloud.name} component {c}",
             info=dict(cloud.info)))
-    return parts, comp
+    return parts, comp, kept
 
 
 def combine_components(datasets, comp, cloud: PointCloud):

@@ -78,18 +78,22 @@ class SurfaceGeometry:
 
     def run(self, ctx):
         """Load and check the cloud (cloud_checks.py: a creased or non-manifold cloud is
-        refused), then one atlas per connected component (:meth:`run_cloud`); several
+        refused; with atlas.allow_creases a creased one runs, its results flagged), then one atlas per connected component (:meth:`run_cloud`); several
         components are reported along dim ``component`` (component_results.py)."""
         from .component_results import checked_components, combine_components
 
         with ctx.timed("source"):
             cloud = ctx.plugin("source").load(ctx.rng("source"))
         with ctx.timed("cloud_checks"):
-            parts, comp = checked_components(cloud, self.settings(ctx).graph_neighbors, ctx.log)
+            s = self.settings(ctx)
+            parts, comp, kept = checked_components(cloud, s.graph_neighbors, ctx.log,
+                                                   allow_creases=s.allow_creases)
         if len(parts) == 1:
             ds = self.run_cloud(ctx, parts[0])
         else:
             ds = combine_components([self.run_cloud(ctx, part) for part in parts], comp, cloud)
+        if kept:  # atlas.allow_creases: the integrals are flagged, never presented as clean
+            ds.attrs["warnings"] = "; ".join(w for w in (kept, ds.attrs.get("warnings")) if w)
         ds["n_isolated_points"] = ((), 0 if comp is None else comp.n_isolated, {
             "long_name": "isolated points dropped (k-NN groups too small for a chart)",
             "units": "1"})

@@ -105,6 +105,25 @@ def test_fold_detected_by_embedding_defects():
     assert fold["flip_fraction"] > 0
 
 
+@pytest.mark.parametrize("turn_degrees", [60.0, 100.0])
+def test_a_chart_across_a_crease_is_not_a_fold(turn_degrees):
+    """Two half-planes meeting at a crease where the normal turns by φ, projected on their
+    bisector plane (a graph: no fold). Triangles straddling the crease have normals up to φ
+    apart, n_t·n_s < 0 past 90°; only a reversal (n_t·n_s < FOLD_COSINE = cos 120°) is a
+    fold. The same points with ξ folded across the crease (ξ = (u, |v|)) fold."""
+    from pointatlas_atlas.partition import FOLD_COSINE
+
+    assert FOLD_COSINE == pytest.approx(np.cos(np.radians(120.0)))
+    rng = np.random.default_rng(3)
+    uv = rng.uniform(-1, 1, (600, 2))
+    slope = np.tan(np.radians(turn_degrees / 2))
+    P = np.column_stack([uv, slope * np.abs(uv[:, 0])])     # normals ±φ/2 off the z axis
+    chart = embedding_defects(P, uv)
+    assert chart["flip_fraction"] == 0.0
+    folded = embedding_defects(P, np.column_stack([uv[:, 0], np.abs(uv[:, 1])]))
+    assert folded["flip_fraction"] > 0.0
+
+
 def test_bad_settings_raise():
     with pytest.raises(ConfigError, match="gamma_pu"):
         make_atlas(gamma_pu=-1.0).build(np.random.default_rng(0).standard_normal((50, 3)))

@@ -5,9 +5,10 @@ from ``experiments/<name>.yaml``; PCA charts as the experiments use), solves it,
 again with the stiffness perturbed by symmetric relative noise of size ``eps`` (default
 1e-15, i.e. a different order of floating-point sums) and prints the relative change of the
 reference displacement. With ``--old PATH`` (a checkout before the physics kit) it also
-solves with the old hand-written assembler's K on the same quadrature. The ghost springs
-(1e-10 × mean diag K) and the augmented-Lagrangian penalty (1e6 × mean diag K) make
-K + ρCᵀC very ill-conditioned, so figures move at the 1e-7 … 1e-5 level under round-off.
+solves with the old hand-written assembler's K on the same quadrature. With the ghost
+springs (1e-10 × mean diag K) and the former augmented-Lagrangian penalty (1e6 × mean diag K)
+figures moved by 2.7e-5 (hemisphere) and 6e-6 (plate) under round-off; with the penalty
+10² × mean diag K (the default since 2026-12-02) by 1.2e-10 and 5.7e-11.
 
 Usage: .venv/bin/python benchmarks/solve_sensitivity.py shell_plate [--old /tmp/oldtree]
 """

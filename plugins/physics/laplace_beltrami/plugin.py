@@ -30,7 +30,7 @@ class LaplaceBeltramiConfig:
     supports: List[Any] = field(default_factory=list)
     ghost_layers: int = 2
     solver: str = "auto"
-    penalty: float = 1.0e6
+    penalty: float = 1.0e2          # AL penalty / mean diag K (as the shell's)
     constraint_tol: float = 1.0e-12
     parameter_constraints: ClassVar[dict] = {
         "c": [Interval(float, 0, None)], "source_term": [Types(str)],

@@ -18,11 +18,11 @@ import tempfile
 import time
 from pathlib import Path
 
-#: name -> (command-line overrides, result variables)
 GEOMETRY = ("area", "relative_error_area", "willmore_energy", "relative_error_willmore_energy",
             "total_gaussian_curvature", "relative_error_total_gaussian_curvature",
             "n_patches", "n_unaccepted_patches")
 SHELL = ("displacement", "relative_error", "n_unaccepted_patches")
+#: name -> (command-line overrides, result variables)
 RUNS = {
     "sphere_willmore": (["experiment=sphere_willmore"], GEOMETRY),
     "sphere_willmore_random": (["experiment=sphere_willmore_random"], GEOMETRY),

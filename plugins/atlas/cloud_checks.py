@@ -300,11 +300,12 @@ def refusal(points: np.ndarray, check: CloudCheck) -> str | None:
     return defects_message(np.asarray(points), check.crease, check.nonmanifold, comp.h)
 
 
-def verdict(points: np.ndarray, check: CloudCheck, allow_creases: bool = False
+def verdict(points: np.ndarray, check: CloudCheck, name: str, allow_creases: bool = False
             ) -> tuple[str | None, str | None]:
-    """(refusal, kept): the one-line reason to refuse the cloud (None if it may run) and,
-    when ``allow_creases`` keeps a cloud whose only defect is crease points, the reason the
-    results must carry as a warning (else None).
+    """(refusal, kept) for the cloud called ``name``: the one-line reason to refuse it (None
+    if it may run) and, when ``allow_creases`` keeps a cloud whose only defect is crease
+    points, the reason the results must carry as a warning (else None); both start with
+    ``name``.
 
     A refusal caused by creases alone names ``atlas.allow_creases``: with it, the run goes on
     and its results are flagged (status completed_with_warnings), never presented as clean.
@@ -315,11 +316,11 @@ def verdict(points: np.ndarray, check: CloudCheck, allow_creases: bool = False
     only_creases = bool(check.crease.any()) and refusal(points, CloudCheck(
         check.components, np.zeros_like(check.crease), check.nonmanifold)) is None
     if allow_creases and only_creases:
-        return None, f"kept by atlas.allow_creases=true, but {reason}"
+        return None, f"{name}: kept by atlas.allow_creases=true, but {reason}"
     if only_creases:
         reason += (" To run anyway with the results flagged as not trustworthy there, set "
                    "atlas.allow_creases=true.")
-    return reason, None
+    return f"{name}: {reason}", None
 
 
 #: coefficient of variation of the nearest-neighbour distance above which a cloud is irregular

@@ -103,10 +103,9 @@ def check_surface_cloud(cloud, n_neighbors: int, allow_creases: bool = False) ->
     from pointatlas_atlas.cloud_checks import check_cloud, components_message, verdict, where
 
     check = check_cloud(cloud.points, n_neighbors)
-    reason, kept = verdict(cloud.points, check, allow_creases)
+    reason, kept = verdict(cloud.points, check, cloud.name, allow_creases)
     if reason:
-        raise InputError(f"{cloud.name}: {reason}")
-    kept = f"{cloud.name}: {kept}" if kept else None
+        raise InputError(reason)
     comp = check.components
     if len(comp.sizes) > 1:
         raise InputError(f"{cloud.name}: {components_message(comp)}; a physics is solved on "

@@ -26,8 +26,9 @@ def checked_components(cloud: PointCloud, n_neighbors: int, log=None,
     results must carry if ``allow_creases`` kept a creased cloud (else None).
 
     Raises InputError (one line, with where and the fix) for creases (unless
-    ``allow_creases``), non-disc neighbourhoods or a cloud too unevenly sampled. Isolated points are dropped (counted in
-    ``Components.n_isolated``, logged); markers follow the component of their nearest point.
+    ``allow_creases``), non-disc neighbourhoods or a cloud too unevenly sampled. Isolated
+    points are dropped (counted in ``Components.n_isolated``, logged); markers follow the
+    component of their nearest point.
     """
     from pointatlas_atlas.cloud_checks import check_cloud, components_message, verdict
     from scipy.spatial import cKDTree
@@ -35,10 +36,9 @@ def checked_components(cloud: PointCloud, n_neighbors: int, log=None,
     if cloud.ambient_dim != 3 or cloud.intrinsic_dim not in (None, 2):
         return [cloud], None, None
     check = check_cloud(cloud.points, n_neighbors)
-    reason, kept = verdict(cloud.points, check, allow_creases)
+    reason, kept = verdict(cloud.points, check, cloud.name, allow_creases)
     if reason:
-        raise InputError(f"{cloud.name}: {reason}")
-    kept = f"{cloud.name}: {kept}" if kept else None
+        raise InputError(reason)
     if log is not None and kept:
         log.warning("%s", kept)
     comp = check.components

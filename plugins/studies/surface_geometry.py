@@ -78,8 +78,9 @@ class SurfaceGeometry:
 
     def run(self, ctx):
         """Load and check the cloud (cloud_checks.py: a creased or non-manifold cloud is
-        refused; with atlas.allow_creases a creased one runs, its results flagged), then one atlas per connected component (:meth:`run_cloud`); several
-        components are reported along dim ``component`` (component_results.py)."""
+        refused; with atlas.allow_creases a creased one runs, its results flagged), then one
+        atlas per connected component (:meth:`run_cloud`); several components are reported
+        along dim ``component`` (component_results.py)."""
         from .component_results import checked_components, combine_components
 
         with ctx.timed("source"):

@@ -13,12 +13,12 @@ import inspect
 
 def stores_config(cls: type) -> type:
     fields = dataclasses.fields(cls.Config)
-    defaults = {}
+    defaults, factories = {}, {}
     for f in fields:
         if f.default is not dataclasses.MISSING:
             defaults[f.name] = f.default
         elif f.default_factory is not dataclasses.MISSING:  # type: ignore[misc]
-            defaults[f.name] = f.default_factory
+            factories[f.name] = f.default_factory  # e.g. list: called, never stored itself
     names = [f.name for f in fields]
 
     def __init__(self, **kwargs):
@@ -29,9 +29,10 @@ def stores_config(cls: type) -> type:
         for name in names:
             if name in kwargs:
                 value = kwargs[name]
+            elif name in factories:
+                value = factories[name]()
             elif name in defaults:
-                d = defaults[name]
-                value = d() if callable(d) and not isinstance(d, type) else copy.deepcopy(d)
+                value = copy.deepcopy(defaults[name])
             else:
                 raise TypeError(f"{cls.__name__}() missing keyword {name!r}")
             setattr(self, name, value)

@@ -35,3 +35,19 @@ def test_unknown_keyword_lists_valid_ones():
 
 def test_passes_the_plugin_contract():
     check_contract(Thing)
+
+
+def test_a_class_as_default_factory_is_called_not_stored():
+    """field(default_factory=list) gives [] (it gave the class ``list`` itself, so
+    kirchhoff_love_fracture's inherited supports were ``list``, not empty)."""
+    @stores_config
+    class Lists:
+        @dataclass
+        class Config:
+            items: List[int] = field(default_factory=list)
+            seen: dict = field(default_factory=dict)
+
+        description = "lists"
+
+    a, b = Lists(), Lists()
+    assert a.items == [] and a.seen == {} and a.items is not b.items

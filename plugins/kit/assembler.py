@@ -73,6 +73,11 @@ class Assembler:
         self.part_names = [f"{type(t.energy).__name__}.{n}" if len(self.terms) > 1 else n
                            for t in self.terms for n in t.energy.density_names]
 
+    def refresh_data(self) -> None:
+        """Recompute every energy's point data (after the caller changed what it depends on,
+        e.g. a degradation or a driving energy between the steps of a staggered solve)."""
+        self.terms = [_Term(t.energy, self.layout, self.q) for t in self.terms]
+
     # -- pointwise evaluation ------------------------------------------------------------
     def _evaluate(self, points, U, want):
         """(dens (n, n_parts), g (n, n_jet) | None, H (n, n_jet, n_jet) | None) at points."""

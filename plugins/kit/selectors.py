@@ -9,6 +9,7 @@ geometric criteria, all AND-ed::
     clamped: {plane: [1, 0, 0, 5.0]}                 # the edge x = 5
     free_edge: {expression: "abs(theta) > 0.69"}     # points by a formula
     hole: {nearest_curve: [0, 0, 10]}                 # the boundary curve nearest to a point
+    crack: {polyline: [[0.3, 0.5, 0], [0.7, 0.5, 0]], on_boundary: false}  # near a curve
     load: {box: [-0.1, -0.1, -1, 0.1, 0.1, 1], on_boundary: false}
 
 Expressions are checked against a whitelist and evaluated on read-only copies of the
@@ -38,6 +39,33 @@ def _vector(selector: Selector, field: str, size: int) -> np.ndarray:
     return arr
 
 
+#: the criteria a selector can combine
+CRITERIA = ("plane", "box", "expression", "nearest_curve", "polyline")
+
+
+def polyline_vertices(selector: Selector) -> np.ndarray:
+    """(k, 3) vertices of ``selector.polyline`` (k ≥ 2 finite points), or ConfigError."""
+    try:
+        V = np.asarray(selector.polyline, dtype=np.float64)
+    except (TypeError, ValueError):
+        V = np.empty((0,))
+    if V.ndim != 2 or V.shape[0] < 2 or V.shape[1] != 3 or not np.isfinite(V).all():
+        raise ConfigError(f"{describe(selector)}: polyline={selector.polyline!r} must be two or "
+                          "more points [x, y, z], e.g. [[0.3, 0.5, 0], [0.7, 0.5, 0]].")
+    return V
+
+
+def distance_to_polyline(X: np.ndarray, V: np.ndarray) -> np.ndarray:
+    """(n,) Euclidean distance of points X (n, 3) to the polyline through vertices V (k, 3)."""
+    d = np.full(len(X), np.inf)
+    for a, b in zip(V[:-1], V[1:]):
+        e = b - a
+        L2 = float(e @ e)
+        t = np.clip(((X - a) @ e) / L2, 0.0, 1.0) if L2 > 0 else np.zeros(len(X))
+        d = np.minimum(d, np.linalg.norm(X - a - t[:, None] * e, axis=1))
+    return d
+
+
 def default_tolerance(points: np.ndarray) -> float:
     """0.25 × median nearest-neighbour distance of the points (length units)."""
     from scipy.spatial import cKDTree
@@ -65,9 +93,9 @@ def select(selector: Selector, points, boundary_mask, curves) -> np.ndarray:
                           "Selector(plane=..., box=..., expression=..., nearest_curve=...).")
     X = np.asarray(points, dtype=np.float64)
     bmask = np.asarray(boundary_mask, dtype=bool)
-    if all(getattr(selector, f) is None for f in ("plane", "box", "expression", "nearest_curve")):
-        raise ConfigError(f"{describe(selector)} has no criterion: give at least one of plane, "
-                          "box, expression, nearest_curve.")
+    if all(getattr(selector, f) is None for f in CRITERIA):
+        raise ConfigError(f"{describe(selector)} has no criterion: give at least one of "
+                          f"{', '.join(CRITERIA)}.")
     tol = selector.tol
     if tol is None:
         tol = default_tolerance(X)
@@ -95,6 +123,8 @@ def select(selector: Selector, points, boundary_mask, curves) -> np.ndarray:
         on_curve = np.zeros(len(X), dtype=bool)
         on_curve[np.asarray(curves[int(np.argmin(dist))])] = True
         keep &= on_curve
+    if selector.polyline is not None:
+        keep &= distance_to_polyline(X, polyline_vertices(selector)) <= tol
     chosen = np.flatnonzero(keep)
     if chosen.size == 0:
         raise InputError(

@@ -127,3 +127,27 @@ def test_selector_is_a_structured_config():
     assert sel.plane == [1.0, 0.0, 0.0, 5.0]
     assert {f.name for f in dataclasses.fields(Selector)} >= {
         "plane", "box", "expression", "nearest_curve", "on_boundary", "tol"}
+
+
+def test_polyline_picks_the_points_within_tol_of_its_segments(plate):
+    """Checked against the brute-force distance to a densely sampled copy of the polyline."""
+    X, mask, curves = plate
+    V = np.array([[-3.0, -1.0, 0.0], [0.5, 0.0, 0.0], [2.0, 3.5, 0.0]])
+    got = select(Selector(polyline=V.tolist(), tol=0.3, on_boundary=False), X, mask, curves)
+    t = np.linspace(0, 1, 20001)[:, None]
+    dense = np.vstack([a + t * (b - a) for a, b in zip(V[:-1], V[1:])])
+    from scipy.spatial import cKDTree
+
+    d = cKDTree(dense).query(X)[0]
+    want = np.flatnonzero(d <= 0.3)
+    sure = np.flatnonzero(np.abs(d - 0.3) > 1e-3)     # away from the tolerance's edge
+    np.testing.assert_array_equal(np.intersect1d(got, sure), np.intersect1d(want, sure))
+    assert len(got) > 10
+
+
+@pytest.mark.parametrize("polyline", [[[0, 0, 0]], [[0, 0], [1, 1]], "line", [[0, 0, np.nan],
+                                                                             [1, 1, 1]]])
+def test_a_malformed_polyline_is_a_config_error(plate, polyline):
+    X, mask, curves = plate
+    with pytest.raises(ConfigError, match="polyline=.*two or more points"):
+        select(Selector(polyline=polyline, on_boundary=False), X, mask, curves)

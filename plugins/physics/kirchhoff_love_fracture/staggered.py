@@ -1,0 +1,178 @@
+"""Staggered minimisation of the fracturing shell at an imposed-displacement factor.
+
+At each increment t (supports C U = t g, loads t F; Amiri et al. 2014 §3, Miehe et al. 2010
+"alternate minimisation"), starting from the previous increment's phase field V_prev:
+
+1. displacement step: U = argmin_U ∫ g(υ) W(U) − t Fᵀ U subject to C U = t g, with
+   g(υ_q) = υ_q² + η_κ̄ frozen at the points (:class:`.degraded_energy.DegradedEnergy` of
+   the shell energy, linearised for ``kinematics: linear``; augmented Lagrangian);
+2. phase step: V = argmin_V crack energy + ∫ (υ² + η) ψ with ψ_q = W(U)_q the undegraded
+   energy density, subject to V ≤ V_prev (:mod:`.phase_solve`; the pre-cracks, held in
+   the initial state, stay broken by it);
+
+repeated until max |ΔV| < ``staggered_tol`` (nodal values, υ being dimensionless), at most
+``max_staggered`` times: an increment that does not converge is refused (PointatlasError
+naming the change reached), never returned as converged. Each step decreases Π, so the
+iteration is monotone; its count per increment is in the results.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from pointatlas.errors import PointatlasError
+
+
+@dataclass
+class FractureState:
+    """A converged increment (or the initial state, factor 0)."""
+
+    factor: float
+    displacement_nodal: np.ndarray     # (n_nodes, 3) U
+    phase_nodal: np.ndarray            # (n_nodes,) V
+    multipliers: np.ndarray            # (rows,) of the supports (reactions −Cᵀμ)
+    staggered_iterations: int
+    energy: dict = field(default_factory=dict)   # elastic, fracture, load_work (energy)
+    reactions: np.ndarray | None = None          # (n_supports, 3) resultant forces
+    changes: list = field(default_factory=list)  # max |ΔV| after each staggered iteration
+
+
+class StaggeredProblem:
+    """The built, supported and loaded fracture problem of one surface model."""
+
+    def __init__(self, model, settings, precrack_nodes, log=None):
+        from scipy.sparse import diags
+
+        from pointatlas_kit.assembler import Assembler
+        from pointatlas_kit.fields import FieldLayout
+        from pointatlas_kit.surface_model import ghost_springs
+        from pointatlas_physics.kirchhoff_love.analysis import ShellModel, assemble_loads, \
+            assemble_supports
+        from pointatlas_physics.kirchhoff_love.material import ShellMaterial
+        from pointatlas_physics.kirchhoff_love.shell_energy import ShellEnergy
+
+        from .degraded_energy import DegradedEnergy, Linearized
+        from .phase_solve import PhaseProblem
+
+        s = self.settings = settings
+        self.model, self.log = model, log
+        material = ShellMaterial(young_modulus=s.young_modulus, poisson_ratio=s.poisson_ratio,
+                                 thickness=s.thickness)
+        material.check()
+        shell = ShellModel(model.points, model.nodes, model.boundary, model.curves,
+                           model.spacing, model.atlas, model.quadrature, model.times,
+                           material=material)
+        self.constraints = assemble_supports(shell, s)
+        self.F = assemble_loads(shell, s, log).ravel()
+        base = ShellEnergy(s.young_modulus, s.poisson_ratio, s.thickness)
+        self.energy_u = DegradedEnergy(Linearized(base))
+        self.layout_u = FieldLayout(base.fields, model.nodes.shape[0])
+        self.assembler_u = Assembler(model.quadrature, self.layout_u, [self.energy_u])
+        K0 = self.assembler_u.tangent(np.zeros(self.layout_u.n_dofs))
+        self.springs = diags(ghost_springs(K0.diagonal(), model, 3))
+        self.phase = PhaseProblem(model, s, precrack_nodes)
+        self.interpolation = model.quadrature.interpolation()
+        #: (support index, imposed displacement at factor 1 (3,)) of 'displacement' supports
+        self.imposed = [(k, np.asarray(sup.value, float)) for k, sup in enumerate(s.supports)
+                        if sup.kind == "displacement"]
+
+    def initial_state(self) -> FractureState:
+        """Factor 0: no displacement; the phase field of the pre-cracks alone (ψ = 0)."""
+        n = self.model.nodes.shape[0]
+        step = self.phase.solve(None, np.ones(n))
+        return FractureState(0.0, np.zeros((n, 3)), step.nodal,
+                             np.zeros(self.constraints.matrix.shape[0]), 0,
+                             {"elastic": 0.0, "fracture": step.energy["fracture"],
+                              "load_work": 0.0}, None, [])
+
+    def displacement_step(self, V, factor):
+        """(U (n_nodes, 3), μ, ψ (m,)) at frozen phase field V."""
+        from pointatlas_solvers.augmented_lagrangian import solve_augmented
+
+        from .phase_field import degradation
+
+        s, cons = self.settings, self.constraints
+        g = degradation(self.interpolation @ V, s.residual_stiffness)
+        self.energy_u.degradation = g
+        self.assembler_u.refresh_data()
+        K = (self.assembler_u.tangent(np.zeros(self.layout_u.n_dofs)) + self.springs).tocsr()
+        U, mu, _ = solve_augmented(K, factor * self.F, cons.matrix, factor * cons.rhs,
+                                   s.penalty, s.constraint_tol, backend=s.solver)
+        psi = self.assembler_u.densities(U).sum(axis=1) / g
+        return U.reshape(-1, 3), mu, np.maximum(psi, 0.0)
+
+    def increment(self, state: FractureState, factor: float) -> FractureState:
+        """The converged staggered solution at ``factor`` from ``state`` (module doc)."""
+        from pointatlas_solvers.increment import support_reactions
+
+        s = self.settings
+        upper = state.phase_nodal
+        V, changes = upper.copy(), []
+        for it in range(1, s.max_staggered + 1):
+            U, mu, psi = self.displacement_step(V, factor)
+            step = self.phase.solve(psi, upper, V, hold_precracks=False)
+            changes.append(float(np.abs(step.nodal - V).max()))
+            V = step.nodal
+            if changes[-1] < s.staggered_tol:
+                break
+        else:
+            raise PointatlasError(
+                f"the staggered solve did not converge at imposed-displacement factor "
+                f"{factor:.6g}: max |Δυ| = {changes[-1]:.3g} after {s.max_staggered} "
+                f"iterations (tolerance {s.staggered_tol:g}). Take smaller increments or raise "
+                "physics.max_staggered.")
+        elastic = self.assembler_u.energy(U.ravel())["total"]
+        energy = {"elastic": elastic, "fracture": step.energy["fracture"],
+                  "load_work": float(factor * self.F @ U.ravel())}
+        reactions = support_reactions(self.constraints.matrix, mu,
+                                      self.constraints.row_support, 3)
+        if self.log is not None:
+            self.log.info("factor %.6g: %d staggered iteration(s), elastic %.6g, fracture "
+                          "%.6g, min υ %.3f", factor, it, elastic, energy["fracture"],
+                          float((self.interpolation @ V).min()))
+        return FractureState(float(factor), U, V, mu, it, energy, reactions, changes)
+
+    def material(self) -> dict:
+        """{young_modulus, poisson_ratio, thickness, fracture_toughness, length_scale,
+        residual_stiffness}: the numbers a study's reference formulas need."""
+        s = self.settings
+        return {k: float(getattr(s, k)) for k in (
+            "young_modulus", "poisson_ratio", "thickness", "fracture_toughness",
+            "length_scale", "residual_stiffness")}
+
+    def point_fields(self, state: FractureState):
+        """(υ (n,), u (n, 3)) at the sampled points (the node basis evaluated once)."""
+        if getattr(self, "_point_basis", None) is None:
+            from pointatlas_atlas.evaluation import basis_at_nodes
+
+            n = self.model.points.shape[0]
+            basis, _, _ = basis_at_nodes(self.model.atlas, np.arange(n), order=0)
+            self._point_basis = basis.to_csr(self.model.nodes.shape[0])
+        B = self._point_basis
+        return B @ state.phase_nodal, B @ state.displacement_nodal
+
+    def restore_state(self, factor, U, V, mu, iterations, energy) -> FractureState:
+        """A converged state from its saved arrays (a resumed path), reactions from μ."""
+        from pointatlas_solvers.increment import support_reactions
+
+        reactions = support_reactions(self.constraints.matrix, mu, self.constraints.row_support,
+                                      3) if factor > 0 else None
+        return FractureState(float(factor), np.asarray(U).reshape(-1, 3), np.asarray(V), mu,
+                             int(iterations), dict(energy), reactions, [])
+
+    def reaction(self, state: FractureState) -> float:
+        """Σ over the imposed-displacement supports of their resultant force along the
+        imposed direction (force): the force that pulls the boundary."""
+        if state.reactions is None or not self.imposed:
+            return 0.0
+        total = 0.0
+        for k, v in self.imposed:
+            n = np.linalg.norm(v)
+            if n > 0:
+                total += float(state.reactions[k] @ (v / n))
+        return total
+
+    def imposed_displacement(self, factor: float) -> float:
+        """|t v| of the first imposed-displacement support (length), 0 without one."""
+        return float(factor * np.linalg.norm(self.imposed[0][1])) if self.imposed else 0.0

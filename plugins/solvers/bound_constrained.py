@@ -17,7 +17,8 @@ with K symmetric positive definite (on the null space of C).
   not) and, once 𝒜 is identified, in one Newton step.
 
 On return U ≤ c holds exactly (U = min(c, ·)), not to a tolerance; the projected gradient
-is below ``tol`` relative to max|F_ρ|. A cap (``max_iter``) that is reached raises rather
+is below ``tol`` relative to max(|F_ρ|, |K_ρ||U|) (the size of the terms the gradient sums,
+whose round-off sets the floor). A cap (``max_iter``) that is reached raises rather
 than returning a point that is not a minimiser.
 """
 from __future__ import annotations
@@ -82,12 +83,14 @@ def _projected_newton(K, F, c, U, tol, backend, max_iter, sigma=1e-4, eps0=1e-6)
     step δ, which has no cancellation (q(U + δ) − q(U) in floating point loses it all near
     the minimiser). ε₀ is relative to max(1, max|c|)."""
     diag = np.maximum(K.diagonal(), 1e-300)
-    scale = max(float(np.abs(F).max(initial=0.0)), float(np.abs(K @ U).max(initial=0.0)),
-                1e-300)
+    absK = abs(K)
     eps0 = eps0 * max(1.0, float(np.abs(c).max(initial=0.0)))
     for it in range(1, max_iter + 1):
         r = K @ U - F
         pg = U - np.minimum(c, U - r / diag)      # scaled projected gradient (units of U)
+        # relative to the size of the terms r sums (its round-off is ~1e-16 of it)
+        scale = max(float(np.abs(F).max(initial=0.0)),
+                    float((absK @ np.abs(U)).max(initial=0.0)), 1e-300)
         if float(np.abs(pg * diag).max(initial=0.0)) <= tol * scale:
             return np.minimum(U, c), it - 1
         eps = min(eps0, float(np.abs(pg).max()))

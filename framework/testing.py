@@ -253,3 +253,29 @@ CHECKS = {
 def check_plugin(family: str, cls: type, **kwargs: Any) -> None:
     """Run the conformance checks of ``family`` ('embedders', 'embedder', ...) on ``cls``."""
     CHECKS[FAMILIES[group_name(family)]](cls, **kwargs)
+
+
+def composed_context(run_dir, overrides=()):
+    """A :class:`~pointatlas.context.RunContext` for config ``overrides`` composed as the CLI
+    composes them (Hydra, the registered configs and experiments), running in ``run_dir``
+    (created): for tests that run a study in-process, e.g. to interrupt and resume it."""
+    from pathlib import Path
+
+    from hydra import compose, initialize_config_dir
+    from omegaconf import OmegaConf, open_dict
+
+    from .config import CONF_DIR, register_configs
+    from .context import RunContext
+    from .registry import FAMILIES
+
+    register_configs()
+    with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
+        cfg = compose("config", overrides=list(overrides), return_hydra_config=True)
+    families = set(FAMILIES.values())
+    choices = {k: v for k, v in cfg.hydra.runtime.choices.items() if k in families and v}
+    with open_dict(cfg):
+        del cfg["hydra"]
+    config = OmegaConf.to_container(cfg, resolve=True)
+    Path(run_dir).mkdir(parents=True, exist_ok=True)
+    return RunContext(config=config, choices=choices, seed=int(config["seed"]),
+                      run_dir=Path(run_dir))

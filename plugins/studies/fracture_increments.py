@@ -16,7 +16,6 @@ import numpy as np
 
 from pointatlas.errors import InputError
 from pointatlas.results import write_netcdf_atomic
-from pointatlas.run_files import remove_partial_files
 
 NAME = "increments.nc"
 FORMAT = "fracture-1"
@@ -100,17 +99,9 @@ def write(path, problem, records, step: float, settings: dict) -> None:
 def read(run_dir, settings: dict):
     """The Dataset of ``run_dir``/increments.nc after checking it is a fracture path's and
     was computed with ``settings`` (InputError / ConfigError naming the fix)."""
-    import xarray as xr
+    from .increment_store import check_settings, load_increments_file
 
-    from .increment_store import check_resume_dir, check_settings
-
-    path = check_resume_dir(run_dir)
-    remove_partial_files(path.parent)
-    try:
-        old = xr.load_dataset(path, engine="netcdf4")
-    except Exception as exc:   # netCDF raises OSError, ValueError, RuntimeError, KeyError
-        raise InputError(f"study.resume_from={run_dir}: {path} cannot be read ({exc}); it is "
-                         "damaged: rerun without study.resume_from.") from exc
+    path, old = load_increments_file(run_dir)
     if old.attrs.get("increments_format") != FORMAT or "resume_settings" not in old.attrs:
         raise InputError(f"study.resume_from={run_dir}: {path} is not the increments file of "
                          "a fracture path; give the run directory of an interrupted "

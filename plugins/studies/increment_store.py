@@ -115,20 +115,26 @@ def check_resume_dir(run_dir) -> Path:
     return path
 
 
-def read_increments(run_dir, settings: dict):
-    """The increments stored in ``run_dir``/increments.nc (oldest first, each with its
-    ``state``), after checking the file is complete and was computed with ``settings``.
-    InputError if the directory or file is missing or unreadable; ConfigError if the
-    settings differ."""
+def load_increments_file(run_dir):
+    """(path, Dataset) of ``run_dir``/increments.nc, after removing what interrupted writes
+    left; InputError naming the fix if it is missing or cannot be read."""
     import xarray as xr
 
     path = check_resume_dir(run_dir)
     remove_partial_files(path.parent)
     try:
-        old = xr.load_dataset(path, engine="netcdf4")
+        return path, xr.load_dataset(path, engine="netcdf4")
     except Exception as exc:   # netCDF raises OSError, ValueError, RuntimeError, KeyError
         raise InputError(f"study.resume_from={run_dir}: {path} cannot be read ({exc}); it is "
                          f"damaged: rerun without study.resume_from.") from exc
+
+
+def read_increments(run_dir, settings: dict):
+    """The increments stored in ``run_dir``/increments.nc (oldest first, each with its
+    ``state``), after checking the file is complete and was computed with ``settings``.
+    InputError if the directory or file is missing or unreadable; ConfigError if the
+    settings differ."""
+    path, old = load_increments_file(run_dir)
     if int(old.attrs.get("increments_format", 1)) < FORMAT or "resume_settings" not in old.attrs:
         raise InputError(f"study.resume_from={run_dir}: {path} was written by an older "
                          "pointatlas without the path state a resume needs; rerun without "

@@ -4,41 +4,29 @@ interrupted after two increments and resumed gives the uninterrupted results."""
 import numpy as np
 import pytest
 import xarray as xr
-from hydra import compose, initialize_config_dir
 
 import pointatlas_studies.fracture_increments as store
-from pointatlas.config import CONF_DIR, register_configs
-from pointatlas.context import RunContext
-from pointatlas.registry import FAMILIES
+from pointatlas.testing import composed_context
 
-# 21 × 21 points (spacing 0.05), κ̄ = 0.1 (2 spacings), a crack of 2a = 0.4 across the centre,
-# pulled to 0.055 in five steps: the crack grows stably from 0.033 on (the reaction peaks at
-# 0.044) and the last step takes ~60 staggered iterations; about 35 s a run
-SMALL = ["experiment=fracture_griffith", "source.n_points=441", "physics.length_scale=0.1",
-         "study.n_increments=5", "study.max_factor=0.55", "study.jump_fraction=0.5"]
+# A full plate [-0.5, 0.5]², 21 × 21 points (spacing 0.05), κ̄ = 0.1 (2 spacings), a crack
+# of 2a = 0.4 across the centre, the bottom edge held, the top pulled to 0.055 in five steps:
+# the crack grows stably from 0.033 on (the reaction peaks at 0.044) and the last step takes
+# ~60 staggered iterations; about 35 s a run
+SMALL = ["experiment=fracture_griffith", "source.model=full", "source.n_points=441",
+         "physics.length_scale=0.1",
+         "physics.precracks=[{polyline: [[-0.2, 0, 0], [0.2, 0, 0]]}]",
+         "physics.supports=[{kind: fixed, components: [1, 2], where: {plane: [0, 1, 0, -0.5]}},"
+         " {kind: displacement, value: [0, 0.1, 0], where: {plane: [0, 1, 0, 0.5]}}]",
+         "study.n_increments=5", "study.max_factor=0.55", "study.jump_fraction=0.5",
+         "study.griffith_half_length=null"]
 
 
 class Killed(BaseException):
     """What a kill -9 leaves: the process stops right after a write, nothing else runs."""
 
 
-def _context(run_dir, *overrides):
-    from omegaconf import OmegaConf, open_dict
-
-    register_configs()
-    with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
-        cfg = compose("config", overrides=[*SMALL, *overrides], return_hydra_config=True)
-    families = set(FAMILIES.values())
-    choices = {k: v for k, v in cfg.hydra.runtime.choices.items() if k in families and v}
-    with open_dict(cfg):
-        del cfg["hydra"]
-    config = OmegaConf.to_container(cfg, resolve=True)
-    run_dir.mkdir(parents=True, exist_ok=True)
-    return RunContext(config=config, choices=choices, seed=int(config["seed"]), run_dir=run_dir)
-
-
 def _run(run_dir, *overrides):
-    ctx = _context(run_dir, *overrides)
+    ctx = composed_context(run_dir, [*SMALL, *overrides])
     return ctx.plugin("study").run(ctx)
 
 

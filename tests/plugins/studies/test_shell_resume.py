@@ -6,13 +6,10 @@ resume from a missing or unusable directory is one clear error."""
 import numpy as np
 import pytest
 import xarray as xr
-from hydra import compose, initialize_config_dir
 
 import pointatlas_studies.increment_store as store
-from pointatlas.config import CONF_DIR, register_configs
-from pointatlas.context import RunContext
 from pointatlas.errors import ConfigError, InputError
-from pointatlas.registry import FAMILIES
+from pointatlas.testing import composed_context
 
 # the open hemisphere at 200 points, three increments to λ = 0.05 (the first tabulated level
 # of Sze et al., so max_relative_error is defined)
@@ -26,23 +23,8 @@ class Killed(BaseException):
     """What a kill -9 leaves: the process stops right after a write, nothing else runs."""
 
 
-def _context(run_dir, *overrides):
-    from omegaconf import OmegaConf, open_dict
-
-    register_configs()
-    with initialize_config_dir(config_dir=str(CONF_DIR), version_base="1.3"):
-        cfg = compose("config", overrides=[*SMALL, *overrides], return_hydra_config=True)
-    families = set(FAMILIES.values())
-    choices = {k: v for k, v in cfg.hydra.runtime.choices.items() if k in families and v}
-    with open_dict(cfg):
-        del cfg["hydra"]
-    config = OmegaConf.to_container(cfg, resolve=True)
-    run_dir.mkdir(parents=True, exist_ok=True)
-    return RunContext(config=config, choices=choices, seed=int(config["seed"]), run_dir=run_dir)
-
-
 def _run(run_dir, *overrides):
-    ctx = _context(run_dir, *overrides)
+    ctx = composed_context(run_dir, [*SMALL, *overrides])
     return ctx.plugin("study").run(ctx)
 
 
@@ -164,7 +146,7 @@ def test_an_interrupted_write_keeps_the_saved_increments_and_is_cleaned(tmp_path
         assert saved.sizes["increment"] == 1
         assert float(saved["load_factor"][0]) == pytest.approx(0.05 / 3)
     # a resume reads the complete file and removes the leftovers
-    ctx = _context(tmp_path / "next")
+    ctx = composed_context(tmp_path / "next", SMALL)
     records = store.read_increments(run_dir, store.run_settings(ctx))
     assert [r.load_factor for r in records] == pytest.approx([0.05 / 3])
     assert records[0].state is not None and records[0].reactions is not None

@@ -5,7 +5,10 @@ The study asks the physics for its built problem (``physics.fracture_path``: the
 module imported) and follows the imposed-displacement factor t from 0 to ``max_factor`` in
 ``n_increments`` equal steps Δt. When the elastic energy drops by more than
 ``jump_fraction`` of its value within a step (a crack jumps), the step is rejected and
-halved, down to Δt · ``min_step_fraction``, where the jump is accepted; after a step
+halved, down to Δt · ``min_step_fraction``, where the jump is accepted; a step whose
+staggered iteration does not converge (it crawls at a jump) is halved too, and at the
+smallest step the path stops there: the converged increments are the results, flagged in
+``warnings`` and ``stopped`` (the run ends ``completed_with_warnings``). After a step
 accepted at the first try without a jump the step doubles again, back to Δt at most.
 
 After every accepted increment ``increments.nc`` in the run directory is rewritten durably
@@ -77,6 +80,7 @@ class FractureStudy:
     def run(self, ctx):
         from pointatlas.errors import ConfigError
         from pointatlas_atlas.plugin import study_atlas_settings
+        from pointatlas_solvers.increment import PathFollowingError
 
         from . import fracture_increments as store
         from .increment_store import run_settings
@@ -99,15 +103,25 @@ class FractureStudy:
                 records, step = [problem.initial_state()], 1.0 / self.n_increments
         path = ctx.run_dir / store.NAME
         full = self.max_factor / self.n_increments
-        rejected = False
+        rejected, stopped = False, ""
         while records[-1].factor < self.max_factor * (1 - 1e-12):
             prev = records[-1]
             dt = min(step * self.max_factor, self.max_factor - prev.factor)
-            with ctx.timed("increments"):
-                new = problem.increment(prev, prev.factor + dt)
+            smallest = full * self.min_step_fraction * (1 + 1e-9)
+            try:
+                with ctx.timed("increments"):
+                    new = problem.increment(prev, prev.factor + dt)
+            except PathFollowingError as exc:   # e.g. the staggered iteration did not converge
+                if dt > smallest:   # alternate minimisation crawls at a crack jump: cut
+                    step /= 2
+                    rejected = True
+                    ctx.log.info("%s Step halved to %.3g.", exc, step * self.max_factor)
+                    continue
+                stopped = f"{exc} (at the smallest step, study.min_step_fraction)"
+                ctx.log.error("path stopped: %s", stopped)
+                break
             drop = (prev.energy["elastic"] - new.energy["elastic"]) / prev.energy["elastic"] \
                 if prev.energy["elastic"] > 0 else 0.0
-            smallest = full * self.min_step_fraction * (1 + 1e-9)
             if drop > self.jump_fraction and dt > smallest:
                 step /= 2
                 rejected = True
@@ -121,6 +135,9 @@ class FractureStudy:
             store.write(path, problem, records, step, settings)
         ds = store.dataset(problem, records)
         ds.attrs["title"] = f"phase-field fracture of {cloud.name}"
+        ds.attrs["stopped"] = stopped or "completed the path"
+        if stopped:   # the converged increments are kept; the run says it did not finish
+            ds.attrs["warnings"] = f"the path stopped before study.max_factor: {stopped}"
         if self.griffith_half_length is not None:
             ds = self._griffith(ds, problem.material())
         return ds

@@ -11,8 +11,8 @@ At each increment t (supports C U = t g, loads t F; Amiri et al. 2014 §3, Miehe
    the initial state, stay broken by it);
 
 repeated until max |ΔV| < ``staggered_tol`` (nodal values, υ being dimensionless), at most
-``max_staggered`` times: an increment that does not converge is refused (PointatlasError
-naming the change reached), never returned as converged. Each step decreases Π, so the
+``max_staggered`` times: an increment that does not converge is refused
+(:class:`StaggeredNotConverged`, naming the change reached), never returned as converged. Each step decreases Π, so the
 iteration is monotone; its count per increment is in the results.
 """
 from __future__ import annotations
@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from pointatlas.errors import PointatlasError
+from pointatlas_solvers.increment import PathFollowingError
 
 
 @dataclass
@@ -36,6 +36,11 @@ class FractureState:
     energy: dict = field(default_factory=dict)   # elastic, fracture, load_work (energy)
     reactions: np.ndarray | None = None          # (n_supports, 3) resultant forces
     changes: list = field(default_factory=list)  # max |ΔV| after each staggered iteration
+
+
+class StaggeredNotConverged(PathFollowingError):
+    """The staggered iteration of an increment did not reach its tolerance (the states of
+    the increments before it are unaffected: a path follower may cut the step)."""
 
 
 class StaggeredProblem:
@@ -117,7 +122,7 @@ class StaggeredProblem:
             if changes[-1] < s.staggered_tol:
                 break
         else:
-            raise PointatlasError(
+            raise StaggeredNotConverged(
                 f"the staggered solve did not converge at imposed-displacement factor "
                 f"{factor:.6g}: max |Δυ| = {changes[-1]:.3g} after {s.max_staggered} "
                 f"iterations (tolerance {s.staggered_tol:g}). Take smaller increments or raise "

@@ -108,3 +108,14 @@ def test_a_resume_with_other_settings_is_refused(tmp_path, monkeypatch):
     with pytest.raises(ConfigError, match="physics.fracture_toughness"):
         _run(tmp_path / "b", f"study.resume_from={tmp_path / 'a'}",
              "physics.fracture_toughness=2e-3")
+
+
+def test_a_staggered_solve_that_does_not_converge_stops_the_path_flagged(tmp_path):
+    """Past the smallest step the path stops: the converged increments are the results and
+    the run says it did not finish (warnings, stopped), never a non-converged state."""
+    ds = _run(tmp_path / "run", "physics.max_staggered=4", "study.n_increments=2",
+              "study.min_step_fraction=0.25")
+    assert "staggered solve did not converge" in ds.attrs["warnings"]
+    assert ds.attrs["stopped"].startswith("the staggered solve did not converge")
+    t = ds["load_factor"].values
+    assert 0 < t[-1] < 0.55 and np.all(ds["staggered_iterations"].values[1:] <= 4)

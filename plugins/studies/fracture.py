@@ -18,7 +18,8 @@ stopped. Results along ``increment``: ``imposed_displacement``, ``reaction``,
 ``elastic_energy``, ``fracture_energy``, ``external_work`` (∫ reaction d(imposed
 displacement) by the trapezoidal rule, plus the work of dead loads t Fᵀu),
 ``staggered_iterations``, ``crack_length`` (fracture energy / (G_c h)), ``min_phase_field``,
-and the fields ``phase_field`` and ``displacement`` at every sampled point.
+and the fields ``phase_field`` and ``displacement`` at every sampled point; the run directory
+gets ``snapshots/increment_NNNN.vtp`` (υ, u and the deformed points) of every increment.
 
 With ``griffith_half_length`` a and ``griffith_width`` W (a plate of width W with a central
 crack 2a pulled normal to it; ``griffith_model: quarter`` for the quarter x, y ≥ 0 with
@@ -134,6 +135,7 @@ class FractureStudy:
             rejected = False
             store.write(path, problem, records, step, settings)
         ds = store.dataset(problem, records)
+        self._snapshots(ctx.run_dir / "snapshots", problem, records)
         ds.attrs["title"] = f"phase-field fracture of {cloud.name}"
         ds.attrs["stopped"] = stopped or "completed the path"
         if stopped:   # the converged increments are kept; the run says it did not finish
@@ -141,6 +143,14 @@ class FractureStudy:
         if self.griffith_half_length is not None:
             ds = self._griffith(ds, problem.material())
         return ds
+
+    @staticmethod
+    def _snapshots(folder, problem, records):
+        """``snapshots/increment_NNNN.vtp`` of every increment (υ, u, deformed shape), written
+        from the records at the end, so a resumed run has them all too."""
+        folder.mkdir(parents=True, exist_ok=True)
+        for k, r in enumerate(records):
+            problem.write_vtp(r, folder / f"increment_{k:04d}.vtp")
 
     def _griffith(self, ds, material):
         """peak_stress, griffith_stress and relative_error (module doc)."""

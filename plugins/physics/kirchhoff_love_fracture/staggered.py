@@ -166,6 +166,26 @@ class StaggeredProblem:
         return FractureState(float(factor), np.asarray(U).reshape(-1, 3), np.asarray(V), mu,
                              int(iterations), dict(energy), reactions, [])
 
+    def write_vtp(self, state: FractureState, path, magnification: float = 1.0):
+        """The sampled points of ``state`` as a ParaView ``.vtp``: ``phase_field`` υ,
+        ``displacement`` u and ``deformed`` = x + magnification·u (temporary name, then
+        renamed)."""
+        import os
+        from pathlib import Path
+
+        import pyvista as pv
+
+        v, u = self.point_fields(state)
+        path = Path(path)
+        cloud = pv.PolyData(np.ascontiguousarray(self.model.points))
+        cloud.point_data["phase_field"] = np.ascontiguousarray(v)
+        cloud.point_data["displacement"] = np.ascontiguousarray(u)
+        cloud.point_data["deformed"] = self.model.points + magnification * u
+        tmp = path.with_name(path.stem + ".partial.vtp")
+        cloud.save(str(tmp))
+        os.replace(tmp, path)
+        return path
+
     def reaction(self, state: FractureState) -> float:
         """Σ over the imposed-displacement supports of their resultant force along the
         imposed direction (force): the force that pulls the boundary."""

@@ -34,6 +34,10 @@ def test_a_path_grows_the_crack_irreversibly_and_resumes_exactly(tmp_path, monke
     """One test, so that the path is computed once per worker: the checks below, then the
     same path killed after two increments and resumed."""
     full = _run(tmp_path / "full")
+    import pyvista as pv
+
+    last = pv.read(tmp_path / "full" / "snapshots" / "increment_0005.vtp")
+    np.testing.assert_array_equal(last.point_data["phase_field"], full["phase_field"][-1])
     _check_growth(full)
     _check_energies(full)
     _check_resume(tmp_path, monkeypatch, full)

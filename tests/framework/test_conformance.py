@@ -10,6 +10,7 @@ SMALL = {
     ("source", "connected_pipes"): {"n_points": 400},
     ("source", "open_pipes"): {"n_points": 600},
     ("embedder", "nlie"): {"n_stress_neighbors": 15, "max_iter": 10, "lbfgs_max_iter": 50},
+    ("physics", "kirchhoff_love_fracture"): {"length_scale": 0.15},   # required, no default
 }
 LINEAR = {("approximant", "lme")}
 

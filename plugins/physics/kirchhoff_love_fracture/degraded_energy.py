@@ -62,3 +62,53 @@ class Linearized:
         g = np.einsum("nij,nj->ni", H0, jets)
         dens = 0.5 * np.einsum("ni,ni->n", jets, g)[:, None]
         return dens, (g if want >= 1 else None), (H0 if want >= 2 else None)
+
+
+class PhaseFieldShellEnergy:
+    """The coupled density of both fields, the thesis' Π per area at one point:
+
+        W(u, υ) = (υ² + η) W_shell(u) + G_c h [(1 − υ)²/(4κ̄) + κ̄ a^αβ υ_,α υ_,β],
+
+    jet (displacement jet of the shell, then (υ, υ_,1, υ_,2)), with the full coupled
+    gradient and Hessian (∂²W/∂u∂υ = 2υ ∂W_shell/∂u): what a monolithic Newton step and the
+    conformance suite's finite-difference check use. Density parts: the shell's parts
+    degraded, then ``fracture``."""
+
+    def __init__(self, shell, crack):
+        from .phase_field import PHASE_FIELD
+
+        self.shell, self.crack = shell, crack
+        self.fields = (*shell.fields, PHASE_FIELD)
+        self.density_names = (*shell.density_names, "fracture")
+        # the suite's frame invariance is zero energy at a rigid motion with the other fields
+        # zero; υ = 0 costs crack energy, so it does not apply (the shell part is invariant)
+        self.frame_invariant = False
+        self.n_u = sum(f.jet_size for f in shell.fields)
+
+    def point_data(self, q) -> np.ndarray:
+        self.crack.driving = None          # the shell energy itself drives υ here
+        return np.column_stack([self.shell.point_data(q), self.crack.point_data(q)])
+
+    def evaluate(self, jets, data, want):
+        n, nu = len(jets), self.n_u
+        du = np.ascontiguousarray(data[:, :-4])
+        dv = np.ascontiguousarray(data[:, -4:])
+        Ws, gs, Hs = self.shell.evaluate(np.ascontiguousarray(jets[:, :nu]), du, want)
+        Wc, gc, Hc = self.crack.evaluate(np.ascontiguousarray(jets[:, nu:]), dv, want)
+        v = jets[:, nu]
+        g = v * v + self.crack.eta
+        W = np.asarray(Ws).sum(axis=1)
+        dens = np.column_stack([np.asarray(Ws) * g[:, None], Wc[:, 0]])
+        G = H = None
+        if want >= 1:
+            G = np.empty((n, nu + 3))
+            G[:, :nu] = g[:, None] * gs
+            G[:, nu:] = gc
+            G[:, nu] += 2.0 * v * W
+        if want >= 2:
+            H = np.zeros((n, nu + 3, nu + 3))
+            H[:, :nu, :nu] = g[:, None, None] * Hs
+            H[:, :nu, nu] = H[:, nu, :nu] = 2.0 * v[:, None] * gs
+            H[:, nu:, nu:] = Hc
+            H[:, nu, nu] += 2.0 * W
+        return dens, G, H

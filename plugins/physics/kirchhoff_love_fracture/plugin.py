@@ -66,17 +66,27 @@ class KirchhoffLoveFracture:
         return s
 
     def energies(self, positions=None) -> list:
-        """The coupled energies of the kit (for the conformance suite): the phase field's
-        crack energy (ψ = 0); the shell part enters through :mod:`.staggered`."""
+        """The coupled energy of both fields (:class:`.degraded_energy.PhaseFieldShellEnergy`:
+        the geometrically exact shell energy degraded by υ² + η, plus the crack energy), the
+        one the conformance suite checks; the staggered solve uses its two halves
+        (:mod:`.staggered`). Needs ``length_scale``."""
+        from pointatlas.errors import ConfigError
+        from pointatlas_physics.kirchhoff_love.shell_energy import ShellEnergy
+
+        from .degraded_energy import PhaseFieldShellEnergy
         from .phase_field import CrackEnergy
 
-        return [CrackEnergy(self.fracture_toughness, self.thickness, self.length_scale or 1.0,
-                            self.residual_stiffness)]
+        if self.length_scale is None:
+            raise ConfigError("physics.length_scale (κ̄) is not set: give the crack band width.")
+        shell = ShellEnergy(self.young_modulus, self.poisson_ratio, self.thickness)
+        crack = CrackEnergy(self.fracture_toughness, self.thickness, self.length_scale,
+                            self.residual_stiffness)
+        return [PhaseFieldShellEnergy(shell, crack)]
 
     def discrete_energy(self, patch: dict):
         from pointatlas_kit.energy import DiscreteEnergy
 
-        return DiscreteEnergy((PHASE_FIELD,), self.energies(), patch)
+        return DiscreteEnergy(self.fields, self.energies(), patch)
 
     # -- building and solving -------------------------------------------------------------
     def build(self, ctx, cloud, atlas_settings):

@@ -9,9 +9,11 @@ settings`, the same keys), plus the phase field (notation of the thesis §4 and 
 ``length_scale``         κ̄ (length): the band width; ℓ = 2κ̄ in the AT2 form. Must span a
                          few point spacings (:data:`MIN_SPACINGS`)
 ``residual_stiffness``   η_κ̄ in (0, 1): stiffness kept by broken material, g(0) = η_κ̄
-``split``                ``none`` (the thesis: all of W degraded); the tension–compression
-                         split ``amor`` (Amor et al. 2009 through the thickness, Kiendl et
-                         al. 2016) is not implemented yet
+``split``                ``none`` (the thesis: all of W degraded), or ``amor``: only the
+                         tensile part of the strain energy at points through the thickness
+                         is degraded and drives the crack (Amor et al. 2009, Kiendl et al.
+                         2016; :mod:`.amor_split`); needs ``kinematics: linear``
+``thickness_points``     Gauss–Legendre points through the thickness of the ``amor`` split
 ``kinematics``           ``linear`` (the shell's linear kinematics), or ``none``: the phase
                          field alone with no driving energy (the crack-band check)
 ``precracks``            selectors ({polyline: …, tol: …}, {box: …}, {expression: …}) of
@@ -30,7 +32,7 @@ from pointatlas.errors import ConfigError
 
 from pointatlas_physics.kirchhoff_love.settings import ShellSettings
 
-SPLITS = ("none",)  # the Amor split (issue 18) is not implemented yet
+SPLITS = ("none", "amor")
 KINEMATICS = ("linear", "none")  # nonlinear kinematics: not yet (see the closing note)
 #: κ̄ must be at least this many median point spacings: below it the band 1 − υ = e^{−|x|/2κ̄}
 #: is not resolved (measured in tests/.../test_crack_band.py: the profile error is
@@ -48,6 +50,7 @@ class FractureSettings(ShellSettings):
     length_scale: Optional[float] = None
     residual_stiffness: float = 1.0e-6
     split: str = "none"
+    thickness_points: int = 5
     precracks: List[Any] = field(default_factory=list)
     staggered_tol: float = 1.0e-4
     max_staggered: int = 200
@@ -59,6 +62,7 @@ class FractureSettings(ShellSettings):
         "length_scale": [*_POSITIVE, None],   # None: refused with its own message (required)
         "residual_stiffness": [Interval(float, 0, 1, closed="neither")],
         "split": [Options(SPLITS)],
+        "thickness_points": [Interval(int, 2, None)],
         "staggered_tol": [Interval(float, 0, 1, closed="neither")],
         "max_staggered": [Interval(int, 1, None)],
     }
@@ -78,6 +82,10 @@ def check_fracture_settings(s: FractureSettings) -> None:
         from pointatlas_physics.kirchhoff_love.settings import check_settings
 
         check_settings(s)
+    elif s.split != "none":
+        raise ConfigError(f"physics.split={s.split} splits the strain energy that drives the "
+                          "crack, and kinematics=none has none: set physics.split=none, or "
+                          "physics.kinematics=linear.")
     elif s.supports or s.loads:
         raise ConfigError("physics.kinematics=none solves the phase field alone: its supports "
                           "and loads would be ignored. Remove them, or set kinematics=linear.")

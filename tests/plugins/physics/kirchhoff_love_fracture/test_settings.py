@@ -11,7 +11,8 @@ BASE = ["experiment=fracture_crack_energy", "source.n_points=441", "physics.leng
     ("physics.length_scale=null", "physics.length_scale (κ̄) is not set"),
     ("physics.residual_stiffness=1.5", "physics.residual_stiffness"),
     ("physics.residual_stiffness=0", "physics.residual_stiffness"),
-    ("physics.split=amor", "physics.split"),
+    ("physics.split=amor", "physics.split=amor splits the strain energy"),
+    ("physics.split=spectral", "physics.split"),
     ("physics.kinematics=nonlinear", "physics.kinematics"),
     ("physics.precracks=[{box:[5,5,5,6,6,6]}]", "physics.precracks[0]"),
     ("physics.precracks=[{}]", "has no criterion"),
@@ -32,3 +33,16 @@ def test_supports_with_the_phase_field_alone_are_refused(tmp_path, run_cli):
                 "physics.supports=[{kind: clamped, where: {plane: [1, 0, 0, 0.5]}}]",
                 f"outputs_root={tmp_path}/out", cwd=tmp_path)
     assert r.returncode != 0 and "kinematics=none solves the phase field alone" in r.stderr
+
+
+def test_the_split_needs_kinematics_that_drive_the_crack():
+    from pointatlas.errors import ConfigError
+    from pointatlas_physics.kirchhoff_love_fracture.settings import (FractureSettings,
+                                                                     check_fracture_settings)
+
+    with pytest.raises(ConfigError, match="kinematics=none has none"):
+        check_fracture_settings(FractureSettings(length_scale=0.1, kinematics="none",
+                                                 split="amor"))
+    with pytest.raises(ConfigError, match="thickness_points"):
+        check_fracture_settings(FractureSettings(length_scale=0.1, split="amor",
+                                                 thickness_points=1))

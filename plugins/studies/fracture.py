@@ -17,8 +17,10 @@ settings) continues from its last increment and gives the results of the run tha
 stopped. Results along ``increment``: ``imposed_displacement``, ``reaction``,
 ``elastic_energy``, ``fracture_energy``, ``external_work`` (∫ reaction d(imposed
 displacement) by the trapezoidal rule, plus the work of dead loads t Fᵀu),
-``staggered_iterations``, ``crack_length`` (fracture energy / (G_c h)), ``min_phase_field``,
-and the fields ``phase_field`` and ``displacement`` at every sampled point; the run directory
+``staggered_iterations``, ``crack_length`` (fracture energy / (G_c h)),
+``min_phase_field_away`` (min υ at the points away from the pre-cracks: where the
+pre-cracks' own band leaves υ₀ ≥ 0.95 at increment 0; every point without pre-crack), and
+the fields ``phase_field`` and ``displacement`` at every sampled point; the run directory
 gets ``snapshots/increment_NNNN.vtp`` (υ, u and the deformed points) of every increment.
 
 With ``griffith_half_length`` a and ``griffith_width`` W (a plate of width W with a central
@@ -30,11 +32,26 @@ with Feddersen's width correction,
     ``griffith_stress`` σ_c = √(E G_c / (π a)) · √(cos(π a / W)),
 
 and ``relative_error`` = peak_stress / σ_c − 1 (E, G_c, h from the physics' ``material``).
+
+The 0-d ``min_phase_field`` is ``min_phase_field_away`` at the last increment: no crack grew
+away from the pre-cracks while it stays near 1. With ``contrast_split`` ('none' or 'amor') the
+same path is followed again with the physics' energy split replaced (``problem.with_split``,
+the same atlas), its figures stored as ``contrast_…`` along ``contrast_increment`` (and
+``contrast_phase_field`` at the last increment): the compression check compares the two. A
+resumed run recomputes the contrast path from its start (it is not in ``increments.nc``;
+deterministic, so the results are those of an uninterrupted run).
+
+``nucleation_displacement`` is the imposed displacement of the first increment whose min υ
+away from the pre-cracks is below 0.1 (NaN: none on the path). With ``halves_plane``
+[nx, ny, nz, d] the points are split by the plane (e.g. the neutral axis of a bent strip):
+``min_phase_field_above`` / ``_below`` along ``increment`` and
+``other_side_min_phase_field``, the min υ on the other side when one side first nucleates
+(near 1: the crack starts on one side only).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import ClassVar, Optional
+from typing import ClassVar, List, Optional
 
 import numpy as np
 
@@ -52,8 +69,11 @@ class FractureStudySettings:
     griffith_half_length: Optional[float] = None
     griffith_width: Optional[float] = None
     griffith_model: str = "full"
+    contrast_split: Optional[str] = None
+    halves_plane: Optional[List[float]] = None
     parameter_constraints: ClassVar[dict] = {
         "griffith_model": [Options(("full", "quarter"))],
+        "contrast_split": [Options(("none", "amor")), None],
         "griffith_half_length": [Interval(float, 0, None, closed="neither"), None],
         "griffith_width": [Interval(float, 0, None, closed="neither"), None],
         "n_increments": [Interval(int, 1, None)],
@@ -61,6 +81,38 @@ class FractureStudySettings:
         "jump_fraction": [Interval(float, 0, 1, closed="neither")],
         "min_step_fraction": [Interval(float, 0, 1, closed="right")],
         "resume_from": [Types(str), None]}
+
+
+HALVES = ("min_phase_field_above", "min_phase_field_below", "other_side_min_phase_field")
+
+
+def halves(ds, plane):
+    """``min_phase_field_above`` / ``_below`` along ``increment`` (min υ away from the
+    pre-cracks on each side n·x ≷ d of ``plane``) and ``other_side_min_phase_field``: at the
+    first increment where one side has nucleated (< 0.1), the min υ on the other side (NaN
+    if neither has): near 1 when the crack starts on one side only."""
+    from .fracture_increments import AWAY, NUCLEATED
+
+    p = np.asarray(plane, dtype=float).ravel()
+    n = p[:3] / np.linalg.norm(p[:3])
+    side = ds["position"].values @ n - p[3] / np.linalg.norm(p[:3])
+    v = ds["phase_field"].values
+    away = v[0] >= AWAY
+    out = {}
+    for name, mask in (("above", away & (side > 0)), ("below", away & (side < 0))):
+        out[name] = v[:, mask].min(axis=1) if mask.any() else np.full(len(v), np.nan)
+        ds[f"min_phase_field_{name}"] = (("increment",), out[name], {
+            "units": "1", "long_name": f"min υ away from the pre-cracks {name} the plane "
+                                       f"{list(map(float, p))} (n·x {'>' if name == 'above' else '<'} d)"})
+    hit = np.flatnonzero(np.fmin(out["above"], out["below"]) < NUCLEATED)
+    other = float("nan")
+    if hit.size:
+        k = hit[0]
+        other = float(out["below"][k] if out["above"][k] < out["below"][k] else out["above"][k])
+    ds["other_side_min_phase_field"] = ((), other, {
+        "units": "1", "long_name": "min υ on the other side of the plane when one side first "
+                                   "has min υ < 0.1"})
+    return ds
 
 
 @stores_config
@@ -73,6 +125,7 @@ class FractureStudy:
                                   "crack jumps, reaction and energies, resumable.")
 
     def check_config(self) -> None:
+        self.check_halves()
         if self.resume_from:
             from .increment_store import check_resume_dir
 
@@ -81,8 +134,6 @@ class FractureStudy:
     def run(self, ctx):
         from pointatlas.errors import ConfigError
         from pointatlas_atlas.plugin import study_atlas_settings
-        from pointatlas_solvers.increment import PathFollowingError
-
         from . import fracture_increments as store
         from .increment_store import run_settings
 
@@ -103,6 +154,70 @@ class FractureStudy:
             with ctx.timed("initial"):
                 records, step = [problem.initial_state()], 1.0 / self.n_increments
         path = ctx.run_dir / store.NAME
+        records, stopped = self._follow(
+            ctx, problem, records, step,
+            lambda recs, st: store.write(path, problem, recs, st, settings))
+        ds = store.dataset(problem, records)
+        self._snapshots(ctx.run_dir / "snapshots", problem, records)
+        ds.attrs["title"] = f"phase-field fracture of {cloud.name}"
+        ds.attrs["stopped"] = stopped or "completed the path"
+        warnings = [f"the path stopped before study.max_factor: {stopped}"] if stopped else []
+        if self.halves_plane is not None:
+            ds = halves(ds, self.halves_plane)
+        if self.contrast_split is not None:
+            ds, note = self._contrast(ctx, problem, ds)
+            warnings += [note] if note else []
+        if warnings:   # the converged increments are kept; the run says it did not finish
+            ds.attrs["warnings"] = "; ".join(warnings)
+        if self.griffith_half_length is not None:
+            ds = self._griffith(ds, problem.material())
+        return ds
+
+    def _contrast(self, ctx, problem, ds):
+        """The same path with the split ``contrast_split`` (module doc): its variables
+        prefixed ``contrast_`` along ``contrast_increment``; (ds, warning or '')."""
+        from . import fracture_increments as store
+
+        other = problem.with_split(self.contrast_split)
+        with ctx.timed("contrast"):
+            records, stopped = self._follow(ctx, other, [other.initial_state()],
+                                            1.0 / self.n_increments, None)
+        c = store.dataset(other, records)
+        keep = ["load_factor", "imposed_displacement", "reaction", "elastic_energy",
+                "fracture_energy", "staggered_iterations", "min_phase_field_away",
+                "min_phase_field", "nucleation_displacement"]
+        if self.halves_plane is not None:
+            c = halves(c, self.halves_plane)
+            keep += list(HALVES)
+        for name in keep:
+            v = c[name].rename({"increment": "contrast_increment"}) if "increment" in \
+                c[name].dims else c[name]
+            ds[f"contrast_{name}"] = v.assign_attrs(
+                long_name=f"{c[name].attrs['long_name']} (split {self.contrast_split})")
+        ds["contrast_phase_field"] = (("point",), c["phase_field"].values[-1], {
+            "units": "1", "long_name": f"phase field υ(x_a) at the last increment (split "
+                                       f"{self.contrast_split})"})
+        ds = ds.assign_coords(contrast_increment=("contrast_increment", np.arange(len(records)),
+                                                  {"units": "1", "long_name": "increment of "
+                                                   "the contrast path (0: initial state)"}))
+        ds.attrs["contrast_split"] = self.contrast_split
+        return ds, (f"the contrast path (split {self.contrast_split}) stopped before "
+                    f"study.max_factor: {stopped}" if stopped else "")
+
+    def check_halves(self):
+        if self.halves_plane is not None:
+            from pointatlas.errors import ConfigError
+
+            p = np.asarray(self.halves_plane, dtype=float).ravel()
+            if p.shape != (4,) or not np.all(np.isfinite(p)) or not np.linalg.norm(p[:3]) > 0:
+                raise ConfigError(f"study.halves_plane = {self.halves_plane!r} must be a plane "
+                                  "[nx, ny, nz, d] (n·x = d, n ≠ 0), e.g. [0, 1, 0, 0].")
+
+    def _follow(self, ctx, problem, records, step, write):
+        """(records, stopped): the increments from ``records[-1]`` to ``max_factor`` (module
+        doc), ``write(records, step)`` after each accepted one (None: not stored)."""
+        from pointatlas_solvers.increment import PathFollowingError
+
         full = self.max_factor / self.n_increments
         rejected, stopped = False, ""
         while records[-1].factor < self.max_factor * (1 - 1e-12):
@@ -133,16 +248,15 @@ class FractureStudy:
             if drop <= self.jump_fraction and not rejected:
                 step = min(2 * step, 1.0 / self.n_increments)
             rejected = False
-            store.write(path, problem, records, step, settings)
-        ds = store.dataset(problem, records)
-        self._snapshots(ctx.run_dir / "snapshots", problem, records)
-        ds.attrs["title"] = f"phase-field fracture of {cloud.name}"
-        ds.attrs["stopped"] = stopped or "completed the path"
-        if stopped:   # the converged increments are kept; the run says it did not finish
-            ds.attrs["warnings"] = f"the path stopped before study.max_factor: {stopped}"
-        if self.griffith_half_length is not None:
-            ds = self._griffith(ds, problem.material())
-        return ds
+            if write is not None:
+                write(records, step)
+        return records, stopped
+
+    @staticmethod
+    def report_figures(ds):
+        from .fracture_figures import fracture_figures
+
+        return fracture_figures(ds)
 
     @staticmethod
     def _snapshots(folder, problem, records):

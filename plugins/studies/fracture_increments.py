@@ -21,6 +21,20 @@ NAME = "increments.nc"
 FORMAT = "fracture-1"
 ONE = {"units": "1"}
 ENERGY = {"units": "energy"}
+#: "away from the pre-cracks": the points where the pre-cracks' own phase field (increment 0,
+#: no load) is at least this, i.e. outside their bands 1 − υ₀ > 0.05 (about 6κ̄ from a
+#: straight pre-crack, υ₀ = 1 − exp(−d/2κ̄)); with no pre-crack, every point
+AWAY = 0.95
+#: a crack has nucleated (or grown) away from the pre-cracks where min υ drops below this
+NUCLEATED = 0.1
+
+
+def nucleation_displacement(delta, away_min) -> float:
+    """The first imposed displacement at which ``away_min`` < :data:`NUCLEATED` (NaN if
+    never): the increment that first shows the crack (no interpolation between increments;
+    the step refinement at a crack jump sets its resolution)."""
+    hit = np.flatnonzero(np.asarray(away_min) < NUCLEATED)
+    return float(delta[hit[0]]) if hit.size else float("nan")
 
 
 def dataset(problem, records):
@@ -38,6 +52,8 @@ def dataset(problem, records):
     s = problem.settings
     fields = [problem.point_fields(r) for r in records]
     phase = np.stack([f[0] for f in fields])
+    away = phase[0] >= AWAY      # none: the bands cover the cloud, NaN (nothing is away)
+    away_min = phase[:, away].min(axis=1) if away.any() else np.full(len(phase), np.nan)
     data = {
         "load_factor": (("increment",), t, {**ONE, "long_name": "imposed-displacement factor t"}),
         "imposed_displacement": (("increment",), delta, {
@@ -57,8 +73,15 @@ def dataset(problem, records):
                                                                   s.thickness) for r in records],
                          {"long_name": "crack length as fracture energy / (G_c h)",
                           "units": "length"}),
-        "min_phase_field": (("increment",), phase.min(axis=1), {
-            **ONE, "long_name": "min υ at the sampled points"}),
+        "min_phase_field_away": (("increment",), away_min, {
+            **ONE, "long_name": f"min υ at the points away from the pre-cracks (their own "
+                                f"band's υ ≥ {AWAY:g} at increment 0)"}),
+        "nucleation_displacement": ((), nucleation_displacement(delta, away_min), {
+            "units": "length", "long_name": f"imposed displacement at which min υ away from "
+                                            f"the pre-cracks first drops below {NUCLEATED:g} "
+                                            f"(NaN: not on this path)"}),
+        "min_phase_field": ((), float(away_min[-1]), {
+            **ONE, "long_name": "min υ away from the pre-cracks at the last increment"}),
         "phase_field": (("increment", "point"), phase, {
             **ONE, "long_name": "phase field υ(x_a) (1 intact, 0 broken)"}),
         "displacement": (("increment", "point", "dim"), np.stack(
@@ -69,11 +92,13 @@ def dataset(problem, records):
         "n_points": ((), n, {**ONE, "long_name": "sampled points"}),
         "n_increments_done": ((), len(records) - 1, {**ONE, "long_name": "accepted increments"}),
     }
-    return xr.Dataset(data, coords={
+    ds = xr.Dataset(data, coords={
         "increment": ("increment", np.arange(len(records)), {
             **ONE, "long_name": "increment (0: the initial state)"}),
         "point": ("point", np.arange(n), {**ONE, "long_name": "point index"}),
         "dim": ("dim", ["x", "y", "z"], {**ONE, "long_name": "Cartesian component"})})
+    ds.attrs["split"] = s.split
+    return ds
 
 
 def write(path, problem, records, step: float, settings: dict) -> None:

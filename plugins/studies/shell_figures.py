@@ -53,7 +53,8 @@ def _shared_range(values: list[np.ndarray], log_scale: bool) -> tuple[float, flo
 
 def snapshot_figure(points, displacements, densities, titles, window=None,
                     log_scale: bool = True, point_size: float = 6.0,
-                    cmap: str = "viridis") -> bytes:
+                    cmap: str = "viridis", clim=None, bar_title: str = "energy density",
+                    view: str = "isometric") -> bytes:
     """PNG bytes: up to 4 off-screen pyvista views of the deformed points x_a + u_a (not
     magnified, thesis Fig. 16/18) coloured by the energy density, one colour range and one
     scalar bar ("energy density", energy per reference area) shared by all views.
@@ -63,6 +64,9 @@ def snapshot_figure(points, displacements, densities, titles, window=None,
     titles : list of str, one per view (VTK's fonts draw Latin-1 only: write "lambda", not
         "λ");  window : (width, height) pixels, default 600 × 500 per view.
     With log_scale, values below max·1e-6 (zeros included) are drawn at that floor.
+    ``clim`` (lo, hi) fixes the colour range (e.g. (0, 1) for a phase field) instead of the
+    shared percentile range; ``bar_title`` names the scalar bar; ``view`` 'isometric' or
+    'xy' (a flat specimen seen from above).
     """
     os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
     import io
@@ -83,7 +87,7 @@ def snapshot_figure(points, displacements, densities, titles, window=None,
         if np.shape(u) != X.shape or v.shape != (X.shape[0],):
             raise InputError(f"snapshot arrays must have shapes {X.shape} (displacement) and "
                              f"({X.shape[0]},) (density); got {np.shape(u)}, {v.shape}.")
-    lo, hi = _shared_range(vals, log_scale)
+    lo, hi = _shared_range(vals, log_scale) if clim is None else map(float, clim)
     shape = (2, 2) if k == 4 else (1, k)
     if window is None:
         window = (600 * shape[1], 500 * shape[0])
@@ -95,17 +99,18 @@ def snapshot_figure(points, displacements, densities, titles, window=None,
         plotter.subplot(*divmod(i, shape[1]))
         x = X + np.asarray(u, dtype=np.float64)
         cloud = pv.PolyData(np.ascontiguousarray(x))
-        cloud.point_data["energy density"] = np.clip(v, lo, None) if log_scale else v
+        cloud.point_data[bar_title] = np.clip(v, lo, None) if log_scale else v
         last = i == k - 1
-        plotter.add_mesh(cloud, scalars="energy density", clim=(lo, hi), cmap=cmap,
+        bar = {**_BAR, "title": bar_title, **({} if log_scale else {"fmt": "%.2f"})}
+        plotter.add_mesh(cloud, scalars=bar_title, clim=(lo, hi), cmap=cmap,
                          log_scale=log_scale, render_points_as_spheres=True,
                          point_size=point_size, nan_color="grey", show_scalar_bar=last,
-                         scalar_bar_args=dict(_BAR) if last else None)
+                         scalar_bar_args=bar if last else None)
         plotter.add_text(str(title), font_size=10, color="black", position="upper_edge")
         bounds[0::2] = np.fmin(bounds[0::2], x.min(axis=0))
         bounds[1::2] = np.fmax(bounds[1::2], x.max(axis=0))
     plotter.link_views()  # one camera for all views, framing every configuration
-    plotter.view_isometric()
+    plotter.view_xy() if view == "xy" else plotter.view_isometric()
     plotter.reset_camera(bounds=bounds)
     image = plotter.screenshot(return_img=True)
     plotter.close()

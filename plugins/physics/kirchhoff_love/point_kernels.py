@@ -31,8 +31,8 @@ CURV_SLOT = np.array([2, 4, 3])  # Voigt component c uses x_,11 / x_,22 / x_,12 
 
 
 @njit(cache=True, nogil=True)
-def voigt_elasticity_point(Y, E, nu, D):
-    """D (3, 3) at one point from the reference tangents Y[0:2] (units of E / chart length⁴)."""
+def contravariant_metric(Y):
+    """G (2, 2) = (a_αβ)⁻¹, the inverse of the metric a_αβ = Y_α · Y_β of the tangents Y[0:2]."""
     a00 = Y[0, 0] * Y[0, 0] + Y[0, 1] * Y[0, 1] + Y[0, 2] * Y[0, 2]
     a11 = Y[1, 0] * Y[1, 0] + Y[1, 1] * Y[1, 1] + Y[1, 2] * Y[1, 2]
     a01 = Y[0, 0] * Y[1, 0] + Y[0, 1] * Y[1, 1] + Y[0, 2] * Y[1, 2]
@@ -42,6 +42,13 @@ def voigt_elasticity_point(Y, E, nu, D):
     G[1, 1] = a00 / det
     G[0, 1] = -a01 / det
     G[1, 0] = -a01 / det
+    return G
+
+
+@njit(cache=True, nogil=True)
+def voigt_elasticity_point(Y, E, nu, D):
+    """D (3, 3) at one point from the reference tangents Y[0:2] (units of E / chart length⁴)."""
+    G = contravariant_metric(Y)
     pa = (0, 1, 0)
     pb = (0, 1, 1)
     s = E / (1.0 - nu * nu)

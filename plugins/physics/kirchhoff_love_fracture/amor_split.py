@@ -41,7 +41,8 @@ import numpy as np
 from numba import njit
 
 from pointatlas_physics.kirchhoff_love.displacement_field import DISPLACEMENT
-from pointatlas_physics.kirchhoff_love.point_kernels import strain_jacobians_point
+from pointatlas_physics.kirchhoff_love.point_kernels import (contravariant_metric,
+                                                             strain_jacobians_point)
 
 DENSITY_NAMES = ("degraded_tensile", "compressive")
 
@@ -49,15 +50,7 @@ DENSITY_NAMES = ("degraded_tensile", "compressive")
 @njit(cache=True, nogil=True)
 def _metric_forms(Y, t, Pd):
     """t (3,) with tr ε = t·e, Pd (3, 3) with |dev ε|² = eᵀ Pd e (Voigt e, metric of Y)."""
-    a00 = Y[0, 0] * Y[0, 0] + Y[0, 1] * Y[0, 1] + Y[0, 2] * Y[0, 2]
-    a11 = Y[1, 0] * Y[1, 0] + Y[1, 1] * Y[1, 1] + Y[1, 2] * Y[1, 2]
-    a01 = Y[0, 0] * Y[1, 0] + Y[0, 1] * Y[1, 1] + Y[0, 2] * Y[1, 2]
-    det = a00 * a11 - a01 * a01
-    G = np.empty((2, 2))
-    G[0, 0] = a11 / det
-    G[1, 1] = a00 / det
-    G[0, 1] = -a01 / det
-    G[1, 0] = -a01 / det
+    G = contravariant_metric(Y)
     t[0], t[1], t[2] = G[0, 0], G[1, 1], G[0, 1]
     pa = (0, 1, 0)
     pb = (0, 1, 1)

@@ -46,7 +46,8 @@ away from the pre-cracks is below 0.1 (NaN: none on the path). With ``halves_pla
 [nx, ny, nz, d] the points are split by the plane (e.g. the neutral axis of a bent strip):
 ``min_phase_field_above`` / ``_below`` along ``increment`` and
 ``other_side_min_phase_field``, the min υ on the other side when one side first nucleates
-(near 1: the crack starts on one side only).
+(near 1: the crack starts on one side only). With ``mirror_plane``: ``symmetry_defect``
+(:mod:`.fracture_symmetry`).
 """
 from __future__ import annotations
 
@@ -71,6 +72,7 @@ class FractureStudySettings:
     griffith_model: str = "full"
     contrast_split: Optional[str] = None
     halves_plane: Optional[List[float]] = None
+    mirror_plane: Optional[List[float]] = None
     parameter_constraints: ClassVar[dict] = {
         "griffith_model": [Options(("full", "quarter"))],
         "contrast_split": [Options(("none", "amor")), None],
@@ -146,6 +148,10 @@ class FractureStudy:
         a = study_atlas_settings(ctx, self)
         a.check()
         cloud = ctx.plugin("source").load(ctx.rng("source"))
+        if self.mirror_plane is not None:      # refused before any work (fracture_symmetry)
+            from .fracture_symmetry import mirror_index
+
+            mirror_index(np.asarray(cloud.points, dtype=float), self.mirror_plane)
         with ctx.timed("build"):
             problem = physics.fracture_path(ctx, cloud=cloud, atlas_settings=a)
         if history is not None:
@@ -164,6 +170,10 @@ class FractureStudy:
         warnings = [f"the path stopped before study.max_factor: {stopped}"] if stopped else []
         if self.halves_plane is not None:
             ds = halves(ds, self.halves_plane)
+        if self.mirror_plane is not None:
+            from .fracture_symmetry import symmetry_defect
+
+            ds = symmetry_defect(ds, self.mirror_plane)
         if self.contrast_split is not None:
             ds, note = self._contrast(ctx, problem, ds)
             warnings += [note] if note else []
@@ -205,13 +215,11 @@ class FractureStudy:
                     f"study.max_factor: {stopped}" if stopped else "")
 
     def check_halves(self):
-        if self.halves_plane is not None:
-            from pointatlas.errors import ConfigError
+        from .fracture_symmetry import check_plane
 
-            p = np.asarray(self.halves_plane, dtype=float).ravel()
-            if p.shape != (4,) or not np.all(np.isfinite(p)) or not np.linalg.norm(p[:3]) > 0:
-                raise ConfigError(f"study.halves_plane = {self.halves_plane!r} must be a plane "
-                                  "[nx, ny, nz, d] (n·x = d, n ≠ 0), e.g. [0, 1, 0, 0].")
+        for key in ("halves_plane", "mirror_plane"):
+            if getattr(self, key) is not None:
+                check_plane(getattr(self, key), key)
 
     def _follow(self, ctx, problem, records, step, write):
         """(records, stopped): the increments from ``records[-1]`` to ``max_factor`` (module

@@ -161,6 +161,28 @@ def open_pipes_area(r: float, a: float, H: float, k: float) -> float:
     return 4.0 * np.pi * r * (2.0 * H + 3.0 * a) + 6.0 * r * r * junction_excess(k / r)
 
 
+def load_pipes(source, rng: np.random.Generator) -> PointCloud:
+    """The cloud of a pipes source (open_pipes, six_pipes): its ``end_circles`` at ring
+    spacing RING_SPACING·h plus ``_interior`` points kept RING_CLEARANCE ring spacings from
+    the ends (n_points in all), and n_markers interior markers (default n_points // 4);
+    randomness only from rng (``sampling: random``)."""
+    check_rng(rng)
+    source._check_common()
+    source._check()
+    n = int(source.n_points)
+    random = rng if source.sampling == "random" else None
+    h = source.spacing(n)
+    rings = source.end_circles(RING_SPACING * h, random)
+    inner = source._interior(n - len(rings), random, RING_CLEARANCE * RING_SPACING * h)
+    points = np.vstack([inner, rings])
+    n_markers = max(4, n // 4) if source.n_markers is None else int(source.n_markers)
+    markers = source._interior(n_markers, random, 0.0)
+    check_distinct(points, what=f"{source.name} points")
+    return PointCloud(points=points, markers=markers, intrinsic_dim=2,
+                      exact={**source._exact(), "spacing": h}, parameters=None,
+                      name=source.name)
+
+
 # -- the source --------------------------------------------------------------------------
 @stores_config
 class OpenPipes(SurfaceSource):
@@ -287,21 +309,7 @@ class OpenPipes(SurfaceSource):
 
     def load(self, rng: np.random.Generator) -> PointCloud:
         """Sample the surface, its end circles and the markers; randomness only from rng."""
-        check_rng(rng)
-        self._check_common()
-        self._check()
-        n = int(self.n_points)
-        random = rng if self.sampling == "random" else None
-        h = self.spacing(n)
-        rings = self.end_circles(RING_SPACING * h, random)
-        inner = self._interior(n - len(rings), random, RING_CLEARANCE * RING_SPACING * h)
-        points = np.vstack([inner, rings])
-        n_markers = max(4, n // 4) if self.n_markers is None else int(self.n_markers)
-        markers = self._interior(n_markers, random, 0.0)
-        check_distinct(points, what=f"{self.name} points")
-        return PointCloud(points=points, markers=markers, intrinsic_dim=2,
-                          exact={**self._exact(), "spacing": h}, parameters=None,
-                          name=self.name)
+        return load_pipes(self, rng)
 
     def _exact(self):
         return {"area": self._area(), "euler_characteristic": -6, "genus": 2,

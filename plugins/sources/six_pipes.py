@@ -29,14 +29,14 @@ from typing import ClassVar, Optional
 
 import numpy as np
 
-from pointatlas.pointcloud import PointCloud, check_distinct
+from pointatlas.pointcloud import PointCloud
 from pointatlas.stores_config import stores_config
 
 from .farthest_point import farthest_point_order
 from .level_set import near_level_set, project_to_level_set
-from .open_pipes import OVERSAMPLING, RING_CLEARANCE, RING_SPACING, _smin
+from .open_pipes import OVERSAMPLING, RING_SPACING, _smin, load_pipes
 from .shell_source import JITTER
-from .surface_source import COMMON_CONSTRAINTS, POSITIVE, SurfaceSource, check_rng, require
+from .surface_source import COMMON_CONSTRAINTS, POSITIVE, SurfaceSource, require
 
 #: Half-width of the candidate shell around F = 0, as a fraction of the pipe radius.
 SHELL_HALF_WIDTH = 0.02
@@ -236,21 +236,7 @@ class SixPipes(SurfaceSource):
 
     def load(self, rng: np.random.Generator) -> PointCloud:
         """Sample the surface, its end circles and the markers; randomness only from rng."""
-        check_rng(rng)
-        self._check_common()
-        self._check()
-        n = int(self.n_points)
-        random = rng if self.sampling == "random" else None
-        h = self.spacing(n)
-        rings = self.end_circles(RING_SPACING * h, random)
-        inner = self._interior(n - len(rings), random, RING_CLEARANCE * RING_SPACING * h)
-        points = np.vstack([inner, rings])
-        n_markers = max(4, n // 4) if self.n_markers is None else int(self.n_markers)
-        markers = self._interior(n_markers, random, 0.0)
-        check_distinct(points, what=f"{self.name} points")
-        return PointCloud(points=points, markers=markers, intrinsic_dim=2,
-                          exact={**self._exact(), "spacing": h}, parameters=None,
-                          name=self.name)
+        return load_pipes(self, rng)
 
     def _exact(self):
         r, H, _ = self._geometry()

@@ -94,10 +94,10 @@ def halves(ds, plane):
     first increment where one side has nucleated (< 0.1), the min υ on the other side (NaN
     if neither has): near 1 when the crack starts on one side only."""
     from .fracture_increments import AWAY, NUCLEATED
+    from .fracture_symmetry import plane_offset
 
     p = np.asarray(plane, dtype=float).ravel()
-    n = p[:3] / np.linalg.norm(p[:3])
-    side = ds["position"].values @ n - p[3] / np.linalg.norm(p[:3])
+    side, _ = plane_offset(ds["position"].values, p)
     v = ds["phase_field"].values
     away = v[0] >= AWAY
     out = {}
@@ -127,7 +127,7 @@ class FractureStudy:
                                   "crack jumps, reaction and energies, resumable.")
 
     def check_config(self) -> None:
-        self.check_halves()
+        self.check_planes()
         if self.resume_from:
             from .increment_store import check_resume_dir
 
@@ -214,7 +214,7 @@ class FractureStudy:
         return ds, (f"the contrast path (split {self.contrast_split}) stopped before "
                     f"study.max_factor: {stopped}" if stopped else "")
 
-    def check_halves(self):
+    def check_planes(self):
         from .fracture_symmetry import check_plane
 
         for key in ("halves_plane", "mirror_plane"):

@@ -31,6 +31,15 @@ def check_plane(plane, key: str) -> np.ndarray:
     return p
 
 
+def plane_offset(points: np.ndarray, plane) -> tuple[np.ndarray, np.ndarray]:
+    """(n·x − d for every row of ``points``, unit normal n) of the plane [nx, ny, nz, d]
+    (n·x = d), normalised: the signed distance to the plane."""
+    p = np.asarray(plane, dtype=float).ravel()
+    norm = np.linalg.norm(p[:3])
+    n = p[:3] / norm
+    return np.asarray(points, dtype=float) @ n - p[3] / norm, n
+
+
 def mirror_index(points: np.ndarray, plane) -> np.ndarray:
     """m (n,) with points[m[a]] the mirror image of points[a], or InputError if the cloud
     is not mirror symmetric about ``plane``."""
@@ -39,9 +48,8 @@ def mirror_index(points: np.ndarray, plane) -> np.ndarray:
     from pointatlas.errors import InputError
 
     p = np.asarray(plane, dtype=float)
-    n = p[:3] / np.linalg.norm(p[:3])
-    d = p[3] / np.linalg.norm(p[:3])
-    image = points - 2.0 * (points @ n - d)[:, None] * n
+    offset, n = plane_offset(points, p)
+    image = points - 2.0 * offset[:, None] * n
     distance, index = cKDTree(points).query(image)
     size = float(np.ptp(points, axis=0).max())
     if distance.max() > MATCH_TOL * size:

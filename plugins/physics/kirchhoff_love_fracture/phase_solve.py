@@ -33,7 +33,10 @@ from pointatlas.errors import InputError
 
 
 #: ghost springs of the phase field, relative to mean diag K (the shell's 1e-10 leaves far
-#: ghost DOFs pivots below PARDISO's perturbation threshold once bounds fix their neighbours)
+#: ghost DOFs pivots below PARDISO's perturbation threshold once bounds fix their neighbours).
+#: They pull toward the intact value υ = 1 (½ s (V − 1)²), so that an unloaded, uncracked
+#: shell has υ ≡ 1 exactly; pulled toward 0 they lowered υ at boundary points of an intact
+#: plate (to 0.9989 at a corner of the 441-point quarter plate, ghost values 0.08)
 GHOST_SPRING = 1e-6
 #: augmented-Lagrangian penalty of the pre-crack rows, relative to mean diag K: the scalar
 #: phase-field system stays well conditioned at 10⁴, and each multiplier update then cuts
@@ -99,7 +102,7 @@ class PhaseProblem:
         K = self.assembler.tangent(zero)
         K = (K + diags(self._springs)).tocsr()
         C, g = (self.C, self.g) if hold_precracks else (csr_matrix((0, K.shape[0])), np.zeros(0))
-        V, info = solve_bounded(K, -R0, C, g, upper, penalty=PRECRACK_PENALTY,
+        V, info = solve_bounded(K, self._springs - R0, C, g, upper, penalty=PRECRACK_PENALTY,
                                 tol=s.constraint_tol, backend=s.solver, start=start)
         if not np.all(np.isfinite(V)):
             raise InputError("the phase-field solve produced NaN/inf: check the material "

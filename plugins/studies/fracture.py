@@ -17,7 +17,9 @@ settings) continues from its last increment and gives the results of the run tha
 stopped. Results along ``increment``: ``imposed_displacement``, ``reaction``,
 ``elastic_energy``, ``fracture_energy``, ``external_work`` (∫ reaction d(imposed
 displacement) by the trapezoidal rule, plus the work of dead loads t Fᵀu),
-``staggered_iterations``, ``crack_length`` (fracture energy / (G_c h)),
+``staggered_iterations``, ``monolithic_iterations`` (0: solved by the staggered scheme),
+``negative_modes`` (of the displacement step's tangent), ``crack_length`` (fracture energy
+/ (G_c h)),
 ``min_phase_field_away`` (min υ at the points away from the pre-cracks: where the
 pre-cracks' own band leaves υ₀ ≥ 0.95 at increment 0; every point without pre-crack), and
 the fields ``phase_field`` and ``displacement`` at every sampled point; the run directory

@@ -69,6 +69,12 @@ def dataset(problem, records):
             **ENERGY, "long_name": "∫ reaction d(imposed displacement) (trapezoidal) + t Fᵀu"}),
         "staggered_iterations": (("increment",), [r.staggered_iterations for r in records], {
             **ONE, "long_name": "staggered iterations of the increment"}),
+        "monolithic_iterations": (("increment",), [r.monolithic_iterations for r in records], {
+            **ONE, "long_name": "Newton iterations of the monolithic solve of the increment "
+                                "(0: solved by the staggered scheme)"}),
+        "negative_modes": (("increment",), [r.negative_modes for r in records], {
+            **ONE, "long_name": "checked negative eigenvalues of the displacement step's "
+                                "tangent (0: u minimises at the frozen phase field)"}),
         "crack_length": (("increment",), [r.energy["fracture"] / (s.fracture_toughness *
                                                                   s.thickness) for r in records],
                          {"long_name": "crack length as fracture energy / (G_c h)",
@@ -151,5 +157,7 @@ def restore(old, problem, run_dir):
             int(old["staggered_iterations"].values[k]),
             {"elastic": float(old["elastic_energy"].values[k]),
              "fracture": float(old["fracture_energy"].values[k]),
-             "load_work": float(old["energy_load_work"].values[k])}))
+             "load_work": float(old["energy_load_work"].values[k])},
+            *(int(old[v].values[k]) if v in old else 0
+              for v in ("negative_modes", "monolithic_iterations"))))
     return states, float(old["controller_step"])

@@ -22,7 +22,11 @@ import numpy as np
 class Equilibrium:
     """R(U, μ, λ), Π_ρ(U; μ, λ), the constrained tangent and the L-BFGS stage of one shell."""
 
-    def __init__(self, model, settings, F: np.ndarray, constraints):
+    def __init__(self, model, settings, F: np.ndarray, constraints, assembler=None):
+        """``assembler``: the kit assembler of the strain energy W (default: the shell's
+        geometrically exact energy on ``model.quadrature``); another energy of the same
+        displacement field, e.g. the shell's degraded by a frozen phase field (the
+        displacement step of ``kirchhoff_love_fracture``), keeps the rest as it is."""
         self.model, self.settings = model, settings
         self.q, self.mat = model.quadrature, model.material
         self.C, self.g = constraints.matrix, constraints.rhs
@@ -42,7 +46,8 @@ class Equilibrium:
 
         from .nonlinear import shell_assembler
 
-        self.assembler = shell_assembler(self.q, self.mat)   # the kit's, pattern cached
+        self.assembler = assembler if assembler is not None else \
+            shell_assembler(self.q, self.mat)                 # the kit's, pattern cached
         K0 = self.assembler.tangent(np.zeros(self.assembler.layout.n_dofs))
         self.springs = ghost_springs(K0.diagonal(), model, 3)
 

@@ -2,8 +2,8 @@
 
 Thesis §4 "Ongoing research" and Amiri, Millán, Shen, Rabczuk & Arroyo, Theor. Appl. Fract.
 Mech. 69 (2014) 102–109, written on the physics kit: the shell's energy
-(:class:`pointatlas_physics.kirchhoff_love.shell_energy.ShellEnergy`, linear kinematics;
-geometrically nonlinear ones are not implemented here yet) degraded by g(υ) = υ² + η_κ̄
+(:class:`pointatlas_physics.kirchhoff_love.shell_energy.ShellEnergy`, geometrically exact for
+``kinematics: nonlinear``, its quadratic form for ``linear``) degraded by g(υ) = υ² + η_κ̄
 (:mod:`.degraded_energy`), a second field υ with the regularised crack energy (:mod:`.phase_field`), irreversibility as a bound
 (:mod:`.phase_solve`) and a staggered solve per imposed-displacement increment
 (:mod:`.staggered`). Notation: G_c ``fracture_toughness``, κ̄ ``length_scale`` (AT2 ℓ = 2κ̄),
@@ -30,9 +30,9 @@ class KirchhoffLoveFracture:
     """Phase-field fracture of a Kirchhoff–Love shell given by points (module doc).
 
     ``solve(ctx, cloud=..., atlas_settings=...)``: with ``kinematics: none`` the phase field
-    alone (pre-cracks, no driving energy) and its crack energy; otherwise the intact shell's
-    linear solve at imposed-displacement factor 1 and the phase field it drives (one
-    staggered increment). Load paths go through :meth:`fracture_path` (study ``fracture``).
+    alone (pre-cracks, no driving energy) and its crack energy; otherwise one staggered
+    increment at imposed-displacement factor 1 from the intact shell (the displacement solve
+    of the chosen kinematics and the phase field it drives). Load paths go through :meth:`fracture_path` (study ``fracture``).
     """
 
     Config = FractureSettings
@@ -150,8 +150,8 @@ class KirchhoffLoveFracture:
         s, model, nodes = self.build(ctx, cloud, atlas_settings)
         if s.kinematics == "none":
             raise ConfigError("study=fracture follows a load path of the shell: set "
-                              "physics.kinematics=linear (kinematics=none is the phase field "
-                              "alone, for study=crack_band).")
+                              "physics.kinematics=linear or nonlinear (kinematics=none is the "
+                              "phase field alone, for study=crack_band).")
         problem = StaggeredProblem(model, s, nodes, log=ctx.log)
         if not problem.imposed and not np.any(problem.F):
             raise ConfigError("study=fracture needs a load: a support of kind 'displacement' "

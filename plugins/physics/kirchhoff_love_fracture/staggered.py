@@ -1,11 +1,17 @@
-"""Staggered minimisation of the fracturing shell at an imposed-displacement factor.
+"""Staggered minimisation of the fracturing shell at an imposed-displacement factor (and,
+with ``scheme: monolithic``, the hand-over to :mod:`.monolithic` first).
 
 At each increment t (supports C U = t g, loads t F; Amiri et al. 2014 §3, Miehe et al. 2010
 "alternate minimisation"), starting from the previous increment's phase field V_prev:
 
 1. displacement step: U = argmin_U ∫ g(υ) W(U) − t Fᵀ U subject to C U = t g, with
    g(υ_q) = υ_q² + η_κ̄ frozen at the points (:class:`.degraded_energy.DegradedEnergy` of
-   the shell energy, linearised for ``kinematics: linear``; augmented Lagrangian);
+   the shell energy, linearised for ``kinematics: linear``, a quadratic solved at once by
+   the augmented Lagrangian; for ``kinematics: nonlinear`` the geometrically exact energy,
+   minimised by the shared solvers' Newton with line search (:func:`pointatlas_solvers.
+   increment.load_increment` on the shell's :class:`Equilibrium` of the degraded energy)
+   from the previous iterate, to ``newton_tol``; its checked count of negative eigenvalues
+   of the tangent (0: a minimum in u at the frozen υ) is kept per increment);
 2. phase step: V = argmin_V crack energy + ∫ (υ² + η) ψ with ψ_q = W(U)_q the undegraded
    energy density, subject to V ≤ V_prev (:mod:`.phase_solve`; the pre-cracks, held in
    the initial state, stay broken by it);
@@ -39,6 +45,11 @@ class FractureState:
     energy: dict = field(default_factory=dict)   # elastic, fracture, load_work (energy)
     reactions: np.ndarray | None = None          # (n_supports, 3) resultant forces
     changes: list = field(default_factory=list)  # max |ΔV| after each staggered iteration
+    #: checked negative eigenvalues of the last displacement step's tangent (nonlinear
+    #: kinematics; 0 for the linear ones, whose degraded energy is convex)
+    negative_modes: int = 0
+    #: Newton iterations of the monolithic solve (0: the staggered scheme solved it)
+    monolithic_iterations: int = 0
 
 
 #: cap on the Newton steps of one displacement step with the amor split (each a linear solve)
@@ -89,12 +100,21 @@ class StaggeredProblem:
 
             self.energy_u = AmorSplitShellEnergy(s.young_modulus, s.poisson_ratio, s.thickness,
                                                  s.thickness_points)
+        elif s.kinematics == "nonlinear":
+            self.energy_u = DegradedEnergy(base)
         else:
             self.energy_u = DegradedEnergy(Linearized(base))
         self.layout_u = FieldLayout(base.fields, model.nodes.shape[0])
         self.assembler_u = Assembler(model.quadrature, self.layout_u, [self.energy_u])
         K0 = self.assembler_u.tangent(np.zeros(self.layout_u.n_dofs))
         self.springs = diags(ghost_springs(K0.diagonal(), model, 3))
+        if s.kinematics == "nonlinear":
+            from pointatlas_physics.kirchhoff_love.equilibrium import Equilibrium
+
+            # the shell's equilibrium problem on the degraded energy (its ghost springs are
+            # those above: both from the intact tangent at U = 0)
+            self.equilibrium = Equilibrium(shell, s, self.F, self.constraints,
+                                           assembler=self.assembler_u)
         self.phase = PhaseProblem(model, s, precrack_nodes)
         self.interpolation = model.quadrature.interpolation()
         #: (support index, imposed displacement at factor 1 (3,)) of 'displacement' supports
@@ -110,24 +130,57 @@ class StaggeredProblem:
                              {"elastic": 0.0, "fracture": step.energy["fracture"],
                               "load_work": 0.0}, None, [])
 
-    def displacement_step(self, V, factor, U0=None):
-        """(U (n_nodes, 3), μ, ψ (m,)) at frozen phase field V; ψ the undegraded driving
-        density (all of W, or its tensile part with ``split: amor``). ``U0`` starts the
-        Newton iteration of the split (a previous solution), ignored without a split."""
-        from .phase_field import degradation
-
+    def displacement_step(self, V, factor, U0=None, mu0=None):
+        """(U (n_nodes, 3), μ, ψ (m,), negative modes) at frozen phase field V; ψ the
+        undegraded driving density (all of W, or its tensile part with ``split: amor``).
+        ``U0`` (and ``mu0``, the supports' multipliers) start the Newton iteration of the
+        split or of the nonlinear kinematics (a previous solution); the linear kinematics
+        without a split ignore them."""
         s = self.settings
-        g = degradation(self.interpolation @ V, s.residual_stiffness)
-        self.energy_u.degradation = g
-        self.assembler_u.refresh_data()
+        g = self._degrade(V)
+        negative = 0
         if s.split == "amor":
             U, mu = self._split_newton(factor, U0)
             psi = self.energy_u.driving(self.assembler_u.densities(U), g)
+        elif s.kinematics == "nonlinear":
+            U, mu, negative = self._nonlinear_newton(factor, U0, mu0)
+            psi = self.assembler_u.densities(U).sum(axis=1) / g
         else:
             U, mu = self._quadratic_solve(self.assembler_u.tangent(
                 np.zeros(self.layout_u.n_dofs)), factor)
             psi = self.assembler_u.densities(U).sum(axis=1) / g
-        return U.reshape(-1, 3), mu, np.maximum(psi, 0.0)
+        return U.reshape(-1, 3), mu, np.maximum(psi, 0.0), negative
+
+    def _degrade(self, V):
+        """Set the displacement energy's degradation to g(υ) of V at the points; g (m,)."""
+        from .phase_field import degradation
+
+        g = degradation(self.interpolation @ V, self.settings.residual_stiffness)
+        self.energy_u.degradation = g
+        self.assembler_u.refresh_data()
+        return g
+
+    def _nonlinear_newton(self, factor, U0, mu0):
+        """(U, μ, checked negative eigenvalues) of the degraded geometrically exact energy at
+        ``factor``: the shared Newton with line search from (U0, μ0) (module doc); refused
+        (:class:`StaggeredNotConverged`) when it does not reach ``newton_tol`` in
+        ``max_newton`` iterations."""
+        from pointatlas_solvers.increment import PathSettings, load_increment
+
+        s, eq = self.settings, self.equilibrium
+        n = self.layout_u.n_dofs
+        U = np.zeros(n) if U0 is None else np.asarray(U0, float).ravel()
+        mu = np.zeros(eq.C.shape[0]) if mu0 is None else np.asarray(mu0, float)
+        path = PathSettings(max_newton=s.max_newton, tol=s.newton_tol, line_search=True)
+        out = load_increment(eq, path, U, mu, float(factor))
+        if out is None:
+            raise StaggeredNotConverged(
+                f"the Newton iteration of a displacement step (kinematics=nonlinear) did not "
+                f"converge at imposed-displacement factor {factor:.6g} in {s.max_newton} "
+                f"iterations to newton_tol {s.newton_tol:g}. Take smaller increments, or raise "
+                "physics.max_newton.")
+        U, mu, _, _, negative = out
+        return U, mu, int(negative)
 
     def _quadratic_solve(self, K, factor):
         """argmin ½ Uᵀ(K + springs)U − t Fᵀ U subject to C U = t g (augmented Lagrangian)."""
@@ -175,15 +228,30 @@ class StaggeredProblem:
             f"{np.abs(d).max():.3g}). Take smaller increments, or use physics.split=none.")
 
     def increment(self, state: FractureState, factor: float) -> FractureState:
-        """The converged staggered solution at ``factor`` from ``state`` (module doc)."""
-        from pointatlas_solvers.increment import support_reactions
-
+        """The converged solution at ``factor`` from ``state``: staggered (module doc), or
+        first the monolithic Newton of :mod:`.monolithic` with ``scheme: monolithic``, the
+        staggered iteration taking over from the same state where that gives up."""
         s = self.settings
+        if s.scheme == "monolithic":
+            from .monolithic import MonolithicNewton, MonolithicNotConverged
+
+            if getattr(self, "_monolithic", None) is None:
+                self._monolithic = MonolithicNewton(self)
+            try:
+                U, V, mu, its = self._monolithic.solve(state, factor)
+            except MonolithicNotConverged as exc:
+                if self.log is not None:
+                    self.log.info("%s: staggered from the same state", exc)
+            else:
+                self._degrade(V)
+                fracture = self.phase.assembler.energy(V)["fracture"]
+                return self._state(factor, U, V, mu, 0, [], 0, fracture, its)
         upper = state.phase_nodal
-        V, changes, U_warm = upper.copy(), [], state.displacement_nodal
+        V, changes = upper.copy(), []
+        U_warm, mu_warm = state.displacement_nodal, state.multipliers
         for it in range(1, s.max_staggered + 1):
-            U, mu, psi = self.displacement_step(V, factor, U_warm)
-            U_warm = U
+            U, mu, psi, negative = self.displacement_step(V, factor, U_warm, mu_warm)
+            U_warm, mu_warm = U, mu
             step = self.phase.solve(psi, upper, V, hold_precracks=False)
             changes.append(float(np.abs(step.nodal - V).max()))
             V = step.nodal
@@ -195,16 +263,29 @@ class StaggeredProblem:
                 f"{factor:.6g}: max |Δυ| = {changes[-1]:.3g} after {s.max_staggered} "
                 f"iterations (tolerance {s.staggered_tol:g}). Take smaller increments or raise "
                 "physics.max_staggered.")
+        return self._state(factor, U, V, mu, it, changes, negative, step.energy["fracture"])
+
+    def _state(self, factor, U, V, mu, it, changes, negative, fracture, monolithic=0):
+        """The FractureState of a converged increment (energies at the degradation of V,
+        which the last displacement step set), logged."""
+        from pointatlas_solvers.increment import support_reactions
+
         elastic = self.assembler_u.energy(U.ravel())["total"]
-        energy = {"elastic": elastic, "fracture": step.energy["fracture"],
+        energy = {"elastic": elastic, "fracture": fracture,
                   "load_work": float(factor * self.F @ U.ravel())}
         reactions = support_reactions(self.constraints.matrix, mu,
                                       self.constraints.row_support, 3)
         if self.log is not None:
-            self.log.info("factor %.6g: %d staggered iteration(s), elastic %.6g, fracture "
-                          "%.6g, min υ %.3f", factor, it, elastic, energy["fracture"],
+            self.log.info("factor %.6g: %s, elastic %.6g, fracture %.6g, min υ %.3f", factor,
+                          f"monolithic Newton, {monolithic} iteration(s)" if monolithic else
+                          f"{it} staggered iteration(s)", elastic, fracture,
                           float((self.interpolation @ V).min()))
-        return FractureState(float(factor), U, V, mu, it, energy, reactions, changes)
+            if negative:
+                self.log.warning("factor %.6g: the displacement step's tangent has %d negative "
+                                 "eigenvalue(s): u is not a minimum at the frozen phase field "
+                                 "(kept in negative_modes)", factor, negative)
+        return FractureState(float(factor), U, V, mu, it, energy, reactions, changes, negative,
+                             monolithic)
 
     def with_split(self, split: str) -> "StaggeredProblem":
         """The same problem (surface model, supports, loads, pre-cracks) with the energy split
@@ -238,14 +319,16 @@ class StaggeredProblem:
         B = self._point_basis
         return B @ state.phase_nodal, B @ state.displacement_nodal
 
-    def restore_state(self, factor, U, V, mu, iterations, energy) -> FractureState:
+    def restore_state(self, factor, U, V, mu, iterations, energy,
+                      negative_modes: int = 0, monolithic_iterations: int = 0) -> FractureState:
         """A converged state from its saved arrays (a resumed path), reactions from μ."""
         from pointatlas_solvers.increment import support_reactions
 
         reactions = support_reactions(self.constraints.matrix, mu, self.constraints.row_support,
                                       3) if factor > 0 else None
         return FractureState(float(factor), np.asarray(U).reshape(-1, 3), np.asarray(V), mu,
-                             int(iterations), dict(energy), reactions, [])
+                             int(iterations), dict(energy), reactions, [], int(negative_modes),
+                            int(monolithic_iterations))
 
     def write_vtp(self, state: FractureState, path, magnification: float = 1.0):
         """The sampled points of ``state`` as a ParaView ``.vtp``: ``phase_field`` υ,

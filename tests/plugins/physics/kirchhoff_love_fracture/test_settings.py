@@ -13,7 +13,7 @@ BASE = ["experiment=fracture_crack_energy", "source.n_points=441", "physics.leng
     ("physics.residual_stiffness=0", "physics.residual_stiffness"),
     ("physics.split=amor", "physics.split=amor splits the strain energy"),
     ("physics.split=spectral", "physics.split"),
-    ("physics.kinematics=nonlinear", "physics.kinematics"),
+    ("physics.kinematics=exact", "physics.kinematics"),
     ("physics.precracks=[{box:[5,5,5,6,6,6]}]", "physics.precracks[0]"),
     ("physics.precracks=[{}]", "has no criterion"),
     ("physics.precracks=[{polyline:[[0,0,0]]}]", "two or more points"),
@@ -43,6 +43,12 @@ def test_the_split_needs_kinematics_that_drive_the_crack():
     with pytest.raises(ConfigError, match="kinematics=none has none"):
         check_fracture_settings(FractureSettings(length_scale=0.1, kinematics="none",
                                                  split="amor"))
+    with pytest.raises(ConfigError, match="kinematics=nonlinear has Green-Lagrange ones"):
+        check_fracture_settings(FractureSettings(length_scale=0.1, kinematics="nonlinear",
+                                                 split="amor"))
+    with pytest.raises(ConfigError, match="physics.max_newton"):
+        check_fracture_settings(FractureSettings(length_scale=0.1, kinematics="nonlinear",
+                                                 max_newton=0))
     with pytest.raises(ConfigError, match="thickness_points"):
         check_fracture_settings(FractureSettings(length_scale=0.1, split="amor",
                                                  thickness_points=1))

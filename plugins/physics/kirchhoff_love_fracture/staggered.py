@@ -231,7 +231,9 @@ class StaggeredProblem:
         """The converged solution at ``factor`` from ``state``: staggered (module doc), or
         first the monolithic Newton of :mod:`.monolithic` with ``scheme: monolithic``, the
         staggered iteration taking over from the same state where that gives up."""
-        s = self.settings
+        import time
+
+        s, self._started = self.settings, time.perf_counter()
         if s.scheme == "monolithic":
             from .monolithic import MonolithicNewton, MonolithicNotConverged
 
@@ -276,9 +278,12 @@ class StaggeredProblem:
         reactions = support_reactions(self.constraints.matrix, mu,
                                       self.constraints.row_support, 3)
         if self.log is not None:
-            self.log.info("factor %.6g: %s, elastic %.6g, fracture %.6g, min υ %.3f", factor,
-                          f"monolithic Newton, {monolithic} iteration(s)" if monolithic else
-                          f"{it} staggered iteration(s)", elastic, fracture,
+            import time
+
+            self.log.info("factor %.6g: %s in %.2f s, elastic %.6g, fracture %.6g, min υ %.3f",
+                          factor, f"monolithic Newton, {monolithic} iteration(s)" if monolithic
+                          else f"{it} staggered iteration(s)",
+                          time.perf_counter() - self._started, elastic, fracture,
                           float((self.interpolation @ V).min()))
             if negative:
                 self.log.warning("factor %.6g: the displacement step's tangent has %d negative "

@@ -7,30 +7,14 @@ staggered iteration; irreversibility holds exactly either way."""
 import numpy as np
 import pytest
 
-from pointatlas.testing import composed_context
-
-# the plate of test_fracture: 441 points, κ̄ = 0.1, a central crack 2a = 0.4, the top edge
-# pulled to 0.055 in five steps (the crack grows from 0.033, jumps in the last step)
-SMALL = ["experiment=fracture_griffith", "source.model=full", "source.n_points=441",
-         "physics.length_scale=0.1",
-         "physics.precracks=[{polyline: [[-0.2, 0, 0], [0.2, 0, 0]]}]",
-         "physics.supports=[{kind: fixed, components: [1, 2], where: {plane: [0, 1, 0, -0.5]}},"
-         " {kind: displacement, value: [0, 0.1, 0], where: {plane: [0, 1, 0, 0.5]}}]",
-         "study.n_increments=5", "study.max_factor=0.55", "study.jump_fraction=0.5",
-         "study.griffith_half_length=null"]
-
-TIGHT = "physics.staggered_tol=1e-7"
-
-
-def _run(run_dir, *overrides):
-    ctx = composed_context(run_dir, [*SMALL, TIGHT, *overrides])
-    return ctx.plugin("study").run(ctx)
+TIGHT = "physics.staggered_tol=1e-7"     # the plate: CENTRE_CRACKED_PLATE in conftest.py
 
 
 @pytest.fixture(scope="module")
-def both(tmp_path_factory):
+def both(tmp_path_factory, run_plate):
     root = tmp_path_factory.mktemp("schemes")
-    return _run(root / "mono", "physics.scheme=monolithic"), _run(root / "stag")
+    return (run_plate(root / "mono", TIGHT, "physics.scheme=monolithic"),
+            run_plate(root / "stag", TIGHT))
 
 
 def test_both_schemes_follow_the_same_path(both):

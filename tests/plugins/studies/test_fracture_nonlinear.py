@@ -17,7 +17,6 @@ import numpy as np
 import pytest
 import xarray as xr
 
-import pointatlas_studies.fracture_increments as store
 from pointatlas.testing import composed_context
 
 E, H, GC, KAPPA, ETA = 1.0, 0.1, 1e-3, 0.05, 1e-6
@@ -27,10 +26,6 @@ CASE = ["experiment=fracture_griffith", "source.n_points=441", f"physics.length_
         "study.n_increments=2", "study.max_factor=0.24", "physics.staggered_tol=1e-9",
         f"physics.young_modulus={E}", f"physics.thickness={H}",
         f"physics.fracture_toughness={GC}", f"physics.residual_stiffness={ETA}"]
-
-
-class Killed(BaseException):
-    """What a kill -9 leaves: the process stops right after a write."""
 
 
 def _run(run_dir, kinematics, *overrides):
@@ -86,19 +81,9 @@ def test_the_linear_kinematics_differ_by_what_the_closed_form_says(tmp_path, non
     np.testing.assert_allclose(lin["reaction"].values[1:], r_lin, rtol=5e-4)
 
 
-def test_a_resumed_nonlinear_path_equals_the_uninterrupted_one(tmp_path, monkeypatch,
+def test_a_resumed_nonlinear_path_equals_the_uninterrupted_one(tmp_path, interrupt_fracture,
                                                                nonlinear):
-    real = store.write
-
-    def write_then_die(path, problem, records, step, settings):
-        real(path, problem, records, step, settings)
-        if len(records) == 2:
-            raise Killed
-
-    monkeypatch.setattr(store, "write", write_then_die)
-    with pytest.raises(Killed):
-        _run(tmp_path / "a", "nonlinear")
-    monkeypatch.setattr(store, "write", real)
+    interrupt_fracture(lambda: _run(tmp_path / "a", "nonlinear"), after=2)
     with xr.open_dataset(tmp_path / "a" / "increments.nc") as saved:
         assert saved.sizes["increment"] == 2
     resumed = _run(tmp_path / "b", "nonlinear", f"study.resume_from={tmp_path / 'a'}")

@@ -1,0 +1,57 @@
+"""Shared pieces of the fracture-path tests: the small centre-cracked plate and a kill -9
+after the n-th durable write of ``increments.nc``."""
+import pytest
+
+#: a full plate [-0.5, 0.5]², 21 × 21 points (spacing 0.05), κ̄ = 0.1 (2 spacings), a crack
+#: of 2a = 0.4 across the centre, the bottom edge held, the top pulled to 0.055 in five
+#: steps: the crack grows stably from 0.033 on (the reaction peaks at 0.044), the last step
+#: is a jump (~60-100 staggered iterations); about 35 s a run
+CENTRE_CRACKED_PLATE = [
+    "experiment=fracture_griffith", "source.model=full", "source.n_points=441",
+    "physics.length_scale=0.1", "physics.precracks=[{polyline: [[-0.2, 0, 0], [0.2, 0, 0]]}]",
+    "physics.supports=[{kind: fixed, components: [1, 2], where: {plane: [0, 1, 0, -0.5]}},"
+    " {kind: displacement, value: [0, 0.1, 0], where: {plane: [0, 1, 0, 0.5]}}]",
+    "study.n_increments=5", "study.max_factor=0.55", "study.jump_fraction=0.5",
+    "study.griffith_half_length=null"]
+
+
+@pytest.fixture(scope="session")
+def run_plate():
+    """run(run_dir, *overrides): study=fracture on :data:`CENTRE_CRACKED_PLATE` in process,
+    its results Dataset."""
+    from pointatlas.testing import composed_context
+
+    def run(run_dir, *overrides):
+        ctx = composed_context(run_dir, [*CENTRE_CRACKED_PLATE, *overrides])
+        return ctx.plugin("study").run(ctx)
+
+    return run
+
+
+class Killed(BaseException):
+    """What a kill -9 leaves: the process stops right after a write, nothing else runs."""
+
+
+@pytest.fixture
+def interrupt_fracture(monkeypatch):
+    """interrupt(run, after): call ``run()`` with every write of increments.nc followed by a
+    kill once it holds ``after`` increments (None: at the first write); the kill is checked
+    to happen, and the real writer is restored."""
+    import pointatlas_studies.fracture_increments as store
+
+    def interrupt(run, after=None):
+        real = store.write
+
+        def write_then_die(path, problem, records, step, settings):
+            real(path, problem, records, step, settings)
+            if after is None or len(records) == after:
+                raise Killed
+
+        monkeypatch.setattr(store, "write", write_then_die)
+        try:
+            with pytest.raises(Killed):
+                run()
+        finally:
+            monkeypatch.setattr(store, "write", real)
+
+    return interrupt

@@ -20,8 +20,9 @@ pivot (its inertia, Sylvester); otherwise, or when no descent is found or the it
 ``max_newton`` is reached, :class:`MonolithicNotConverged` is raised and the increment is
 solved by the staggered scheme from the same state (the study records which did it).
 Converged: the supports' residual below ``newton_tol`` of the force scale, the active set
-unchanged, and the last step below 1e-3 ``staggered_tol`` in V (dimensionless) and 1e-8 of
-max |U| in U.
+unchanged, and the last step below 1e-3 ``staggered_tol`` (at least :data:`V_STEP`) in V
+(dimensionless) and
+:data:`U_STEP` of max |U| in U.
 """
 from __future__ import annotations
 
@@ -31,6 +32,16 @@ from .staggered import StaggeredNotConverged
 
 #: Armijo constant and the smallest backtracking factor of a step
 ARMIJO, MIN_STEP = 1e-4, 1e-6
+#: a step whose predicted change of Π is below this fraction of |Π| is taken in full: the
+#: Armijo test cannot see it through the round-off (on the 1 681-point Griffith plate every
+#: elastic increment stalled there, "no descent", after 12-22 iterations, without this)
+ROUND_OFF = 1e-12
+#: the last U step, relative to max |U|, below which U is converged (with the residual): the
+#: steps stall at 1-3e-8 on that plate, the floor the constraint solve's tolerance leaves,
+#: while the residual is at 1e-10 of the reactions; 1e-8 there never converged
+U_STEP = 1e-6
+#: floor of the V step test (dimensionless): the steps stall at 1-3e-10 (round-off)
+V_STEP = 1e-9
 
 
 class MonolithicNotConverged(StaggeredNotConverged):
@@ -119,7 +130,11 @@ class MonolithicNewton:
                 Xn = X + alpha * d
                 Xn[self.v] = np.minimum(upper, Xn[self.v])
                 Pn, Rn = self._energy(Xn, factor)
-                if not feasible or Pn <= Pi + ARMIJO * float(R @ (Xn - X)):
+                slope = float(R @ (Xn - X))
+                # the change Newton predicts is below the round-off of Π: nothing to test
+                # (near the minimiser Π(X + d) − Π(X) is all cancellation)
+                lost = abs(slope) <= ROUND_OFF * max(abs(Pi), abs(Pn), 1e-300)
+                if not feasible or lost or Pn <= Pi + ARMIJO * slope:
                     break
                 alpha *= 0.5
                 if alpha < MIN_STEP:
@@ -130,8 +145,9 @@ class MonolithicNewton:
             RU = R[self.u] + (self.C.T @ mu)[self.u]
             scale = max(float(np.linalg.norm(factor * self.F)),
                         float(np.linalg.norm(self.C.T @ mu)), 1e-300)
-            small_u = np.abs(step[self.u]).max() <= 1e-8 * max(np.abs(X[self.u]).max(), 1e-300)
-            small_v = np.abs(step[self.v]).max() <= 1e-3 * s.staggered_tol
+            u_max = max(np.abs(X[self.u]).max(), 1e-300)
+            small_u = np.abs(step[self.u]).max() <= U_STEP * u_max
+            small_v = np.abs(step[self.v]).max() <= max(1e-3 * s.staggered_tol, V_STEP)
             same = active_before is not None and np.array_equal(held, active_before)
             active_before = held
             if np.linalg.norm(RU) <= s.newton_tol * scale and small_u and small_v and same:

@@ -8,10 +8,10 @@ together. The coupled energy per area is :class:`.degraded_energy.PhaseFieldShel
 (W_shell the shell's linearised or geometrically exact energy), assembled by the kit on the
 two-field layout (node block (u₁, u₂, u₃, υ)); its Hessian holds ∂²W/∂u∂υ = 2υ ∂W_shell/∂u.
 Each iteration is a projected Newton step (Bertsekas, SIAM J. Control Optim. 20 (1982) 221):
-with R = ∂Π/∂X, the irreversibility bounds held are 𝒜 = {V_i ≥ V_prev,i − ε, R_Vi < 0}; on the
-free unknowns (all of U and V off 𝒜) the step minimises the quadratic model subject to the
+with R = ∂Π/∂X, the bounds held are 𝒜 = {V_i ≥ V_prev,i − ε, R_Vi < 0} (irreversibility) ∪
+{V_i ≤ ε, R_Vi > 0} (υ ≥ 0, see :mod:`.phase_solve`); on the free unknowns (all of U and V off 𝒜) the step minimises the quadratic model subject to the
 supports C U = t g (augmented Lagrangian, the shared :class:`ConstrainedSystem`), then V is
-projected onto V ≤ V_prev and the step is backtracked (Armijo on Π) once U is feasible.
+projected onto 0 ≤ V ≤ V_prev and the step is backtracked (Armijo on Π) once U is feasible.
 
 *Where it converges.* The AT2 energy is convex in u and in υ separately, not jointly: past
 the onset of softening the coupled tangent on the free set is indefinite and a Newton step
@@ -101,17 +101,20 @@ class MonolithicNewton:
 
         s, N = self.settings, self.layout.n_dofs
         upper = state.phase_nodal
+        lower = np.minimum(0.0, upper)     # υ ≥ 0, below a pre-crack's own values (phase_solve)
         X = np.empty(N)
         X[self.u], X[self.v] = state.displacement_nodal.ravel(), upper
         feasible, active_before = False, None
         Pi, R = self._energy(X, factor)
         for it in range(1, s.max_newton + 1):
             V = X[self.v]
-            eps = min(1e-9, float(np.abs(V - np.minimum(upper, V - R[self.v])).max()))
+            eps = min(1e-9, float(np.abs(V - np.clip(V - R[self.v], lower, upper)).max()))
             held = (V >= upper - eps) & (R[self.v] < 0)
+            floor = (V <= lower + eps) & (R[self.v] > 0) & ~held
             free = np.ones(N, bool)
-            free[self.v[held]] = False
+            free[self.v[held | floor]] = False
             X[self.v[held]] = upper[held]
+            X[self.v[floor]] = lower[floor]
             f = np.flatnonzero(free)
             K = (self.assembler.tangent(X) + diags(self.springs)).tocsr()[f][:, f]
             system = ConstrainedSystem(K, self.C[:, f], s.penalty, s.constraint_tol,
@@ -128,7 +131,7 @@ class MonolithicNewton:
             alpha = 1.0
             while True:
                 Xn = X + alpha * d
-                Xn[self.v] = np.minimum(upper, Xn[self.v])
+                Xn[self.v] = np.clip(Xn[self.v], lower, upper)
                 Pn, Rn = self._energy(Xn, factor)
                 slope = float(R @ (Xn - X))
                 # the change Newton predicts is below the round-off of Π: nothing to test

@@ -7,7 +7,16 @@ minimised subject to
 * the pre-cracks, υ(x_k) = Σ_b p_b(x_k) V_b = 0 at the points the selectors pick (C V = 0,
   augmented Lagrangian, :mod:`pointatlas_kit.supports`), imposed in the initial state, and
 * irreversibility as the bound V ≤ V_prev on every nodal value (the previous increment's),
-  by projected Newton (:mod:`pointatlas_solvers.bound_constrained`).
+  and the range as V ≥ 0, both by projected Newton
+  (:mod:`pointatlas_solvers.bound_constrained`).
+
+Why V ≥ 0: the LME stiffness is not an M-matrix, so the discrete problem has no maximum
+principle, and next to a fully broken band the nodal values overshoot below 0 (to −0.026 on
+the 441-point Griffith quarter plate with a traction-free crack). g(υ) = υ² + η is even, so
+the energy hardly notices, but υ < 0 is outside the model. The pre-crack rows are the
+exception: Σ p_b(x_k) V_b = 0 with every V_b ≥ 0 would force V_b = 0 on the whole support of
+every pre-crack point (several spacings wide, for a positive basis), so the nodes those rows
+touch are free below in the initial state, and afterwards bounded below by min(0, V_prev).
 
 After the initial state the pre-crack rows are implied: υ(x_k) = Σ p_b(x_k) V_b ≤
 Σ p_b(x_k) V_prev,b = 0, so a pre-crack stays broken (υ ≤ 0 there) by irreversibility alone.
@@ -86,7 +95,7 @@ class PhaseProblem:
         self._springs = ghost_springs(K0.diagonal(), model, 1, GHOST_SPRING)
 
     def solve(self, driving, upper, start=None, hold_precracks: bool = True) -> PhaseStep:
-        """Minimise at driving energy density ``driving`` (m,) (None: 0) with V ≤ ``upper``,
+        """Minimise at driving energy density ``driving`` (m,) (None: 0) with 0 ≤ V ≤ ``upper``,
         holding the pre-crack rows as equalities if ``hold_precracks`` (module doc)."""
         from scipy.sparse import csr_matrix
 
@@ -102,8 +111,12 @@ class PhaseProblem:
         K = self.assembler.tangent(zero)
         K = (K + diags(self._springs)).tocsr()
         C, g = (self.C, self.g) if hold_precracks else (csr_matrix((0, K.shape[0])), np.zeros(0))
+        lower = np.minimum(0.0, upper)
+        if C.shape[0]:
+            lower[np.unique(C.tocsr().indices)] = -np.inf
         V, info = solve_bounded(K, self._springs - R0, C, g, upper, penalty=PRECRACK_PENALTY,
-                                tol=s.constraint_tol, backend=s.solver, start=start)
+                                tol=s.constraint_tol, backend=s.solver, start=start,
+                                lower=lower)
         if not np.all(np.isfinite(V)):
             raise InputError("the phase-field solve produced NaN/inf: check the material "
                              "parameters and the pre-crack selectors.")

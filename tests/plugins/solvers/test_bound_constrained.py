@@ -65,3 +65,39 @@ def test_mismatched_sizes_are_refused():
     K, F, c = _laplacian_problem(10, 0)
     with pytest.raises(InputError, match="agree on 10 unknowns"):
         solve_bounded(K, F[:5], None, np.zeros(0), c)
+
+
+@settings(max_examples=25, deadline=None)
+@given(n=st.integers(5, 40), seed=st.integers(0, 10_000))
+def test_two_sided_bounds_meet_the_kkt_conditions(n, seed):
+    K, F, c = _laplacian_problem(n, seed)
+    lo = c - np.random.default_rng(seed + 1).uniform(0.05, 0.6, size=n)
+    U, info = solve_bounded(K, F, None, np.zeros(0), c, lower=lo)
+    assert np.all(U <= c) and np.all(U >= lo)     # exactly, not to a tolerance
+    mu = F - K @ U
+    at_c, at_lo = U == c, U == lo
+    atol = 1e-10 * np.abs(F).max()
+    assert np.all(mu[at_c] >= -atol) and np.all(mu[at_lo] <= atol)
+    np.testing.assert_allclose(mu[~(at_c | at_lo)], 0.0, atol=1e-9 * np.abs(F).max())
+    assert info.n_active == (at_c | at_lo).sum()
+
+
+def test_two_sided_bounds_agree_with_scipy_lbfgsb():
+    rng = np.random.default_rng(11)
+    n = 25
+    A = rng.normal(size=(n, n))
+    K = A @ A.T + n * np.eye(n)
+    F = rng.normal(size=n) * 10
+    lo, c = -0.2 * np.ones(n), 0.3 * np.ones(n)
+    U, info = solve_bounded(csr_matrix(K), F, None, np.zeros(0), c, lower=lo)
+    ref = minimize(lambda x: 0.5 * x @ K @ x - F @ x, np.zeros(n), jac=lambda x: K @ x - F,
+                   bounds=list(zip(lo, c)), method="L-BFGS-B",
+                   options={"ftol": 1e-15, "gtol": 1e-12, "maxiter": 10_000})
+    assert (U == lo).any() and (U == c).any()         # both bounds bind somewhere
+    np.testing.assert_allclose(U, ref.x, atol=1e-6)
+
+
+def test_crossed_bounds_are_refused():
+    K, F, c = _laplacian_problem(10, 0)
+    with pytest.raises(InputError, match="lower bound exceeds the upper"):
+        solve_bounded(K, F, None, np.zeros(0), c, lower=c + 1.0)

@@ -12,7 +12,7 @@ CENTRE_CRACKED_PLATE = [
     "physics.supports=[{kind: fixed, components: [1, 2], where: {plane: [0, 1, 0, -0.5]}},"
     " {kind: displacement, value: [0, 0.1, 0], where: {plane: [0, 1, 0, 0.5]}}]",
     "study.n_increments=5", "study.max_factor=0.55", "study.jump_fraction=0.5",
-    "study.griffith_half_length=null"]
+    "study.griffith_half_length=null", "study.min_step_fraction=0.125"]
 
 
 @pytest.fixture(scope="session")

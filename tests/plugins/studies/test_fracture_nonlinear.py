@@ -25,7 +25,12 @@ CASE = ["experiment=fracture_griffith", "source.n_points=441", f"physics.length_
         "physics.precracks=[]", "study.griffith_half_length=null", "atlas.quadrature_order=5",
         "study.n_increments=2", "study.max_factor=0.24", "physics.staggered_tol=1e-9",
         f"physics.young_modulus={E}", f"physics.thickness={H}",
-        f"physics.fracture_toughness={GC}", f"physics.residual_stiffness={ETA}"]
+        f"physics.fracture_toughness={GC}", f"physics.residual_stiffness={ETA}",
+        # the whole edge y = 0 held (fracture_griffith holds only its ligament): uniaxial
+        "physics.supports=[{kind: symmetry, normal: [1, 0, 0], where: {plane: [1, 0, 0, 0]}},"
+        " {kind: symmetry, normal: [0, 1, 0], where: {plane: [0, 1, 0, 0]}},"
+        " {kind: displacement, components: [1, 2], value: [0, 0.1, 0],"
+        " where: {plane: [0, 1, 0, 0.5]}}]"]
 
 
 def _run(run_dir, kinematics, *overrides):

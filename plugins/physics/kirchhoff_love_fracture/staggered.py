@@ -26,6 +26,7 @@ plain and depth 3 did not converge in 60.)
 """
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -231,9 +232,7 @@ class StaggeredProblem:
         """The converged solution at ``factor`` from ``state``: staggered (module doc), or
         first the monolithic Newton of :mod:`.monolithic` with ``scheme: monolithic``, the
         staggered iteration taking over from the same state where that gives up."""
-        import time
-
-        s, self._started = self.settings, time.perf_counter()
+        s, started = self.settings, time.perf_counter()
         if s.scheme == "monolithic":
             from .monolithic import MonolithicNewton, MonolithicNotConverged
 
@@ -247,7 +246,7 @@ class StaggeredProblem:
             else:
                 self._degrade(V)
                 fracture = self.phase.assembler.energy(V)["fracture"]
-                return self._state(factor, U, V, mu, 0, [], 0, fracture, its)
+                return self._state(factor, U, V, mu, 0, [], 0, fracture, started, its)
         upper = state.phase_nodal
         V, changes = upper.copy(), []
         U_warm, mu_warm = state.displacement_nodal, state.multipliers
@@ -265,11 +264,14 @@ class StaggeredProblem:
                 f"{factor:.6g}: max |Δυ| = {changes[-1]:.3g} after {s.max_staggered} "
                 f"iterations (tolerance {s.staggered_tol:g}). Take smaller increments or raise "
                 "physics.max_staggered.")
-        return self._state(factor, U, V, mu, it, changes, negative, step.energy["fracture"])
+        return self._state(factor, U, V, mu, it, changes, negative, step.energy["fracture"],
+                           started)
 
-    def _state(self, factor, U, V, mu, it, changes, negative, fracture, monolithic=0):
+    def _state(self, factor, U, V, mu, it, changes, negative, fracture, started,
+               monolithic=0):
         """The FractureState of a converged increment (energies at the degradation of V,
-        which the last displacement step set), logged."""
+        which the last displacement step set), logged with the wall time since ``started``
+        (time.perf_counter() when the increment began)."""
         from pointatlas_solvers.increment import support_reactions
 
         elastic = self.assembler_u.energy(U.ravel())["total"]
@@ -278,12 +280,10 @@ class StaggeredProblem:
         reactions = support_reactions(self.constraints.matrix, mu,
                                       self.constraints.row_support, 3)
         if self.log is not None:
-            import time
-
             self.log.info("factor %.6g: %s in %.2f s, elastic %.6g, fracture %.6g, min υ %.3f",
                           factor, f"monolithic Newton, {monolithic} iteration(s)" if monolithic
                           else f"{it} staggered iteration(s)",
-                          time.perf_counter() - self._started, elastic, fracture,
+                          time.perf_counter() - started, elastic, fracture,
                           float((self.interpolation @ V).min()))
             if negative:
                 self.log.warning("factor %.6g: the displacement step's tangent has %d negative "

@@ -29,19 +29,27 @@ def test_kkt_conditions_hold(n, seed):
     assert info.n_active == active.sum()
 
 
-def test_agrees_with_scipy_lbfgsb_on_a_dense_problem():
-    rng = np.random.default_rng(3)
-    n = 25
+def _dense_problem(seed, n=25):
+    """A dense SPD K (not an M-matrix) with a large random load."""
+    rng = np.random.default_rng(seed)
     A = rng.normal(size=(n, n))
-    K = A @ A.T + n * np.eye(n)
-    F = rng.normal(size=n) * 10
-    c = rng.normal(size=n)
+    return A @ A.T + n * np.eye(n), rng.normal(size=n) * 10, rng
+
+
+def _lbfgsb(K, F, start, bounds):
+    """scipy's L-BFGS-B minimiser of ½xᵀKx − Fᵀx in ``bounds`` (the independent answer)."""
+    return minimize(lambda x: 0.5 * x @ K @ x - F @ x, start, jac=lambda x: K @ x - F,
+                    bounds=bounds, method="L-BFGS-B",
+                    options={"ftol": 1e-15, "gtol": 1e-12, "maxiter": 10_000}).x
+
+
+def test_agrees_with_scipy_lbfgsb_on_a_dense_problem():
+    K, F, rng = _dense_problem(3)
+    c = rng.normal(size=len(F))
     U, info = solve_bounded(csr_matrix(K), F, None, np.zeros(0), c)
-    ref = minimize(lambda x: 0.5 * x @ K @ x - F @ x, np.minimum(0, c), jac=lambda x: K @ x - F,
-                   bounds=[(None, b) for b in c], method="L-BFGS-B",
-                   options={"ftol": 1e-15, "gtol": 1e-12, "maxiter": 10_000})
-    assert info.n_active > 0 and info.n_active < n     # the bounds bind, not all of them
-    np.testing.assert_allclose(U, ref.x, atol=1e-6)
+    assert info.n_active > 0 and info.n_active < len(F)     # the bounds bind, not all of them
+    np.testing.assert_allclose(U, _lbfgsb(K, F, np.minimum(0, c), [(None, b) for b in c]),
+                               atol=1e-6)
 
 
 def test_with_equality_constraints_matches_the_kkt_system_of_the_final_active_set():
@@ -83,18 +91,11 @@ def test_two_sided_bounds_meet_the_kkt_conditions(n, seed):
 
 
 def test_two_sided_bounds_agree_with_scipy_lbfgsb():
-    rng = np.random.default_rng(11)
-    n = 25
-    A = rng.normal(size=(n, n))
-    K = A @ A.T + n * np.eye(n)
-    F = rng.normal(size=n) * 10
-    lo, c = -0.2 * np.ones(n), 0.3 * np.ones(n)
+    K, F, _ = _dense_problem(11)
+    lo, c = -0.2 * np.ones(len(F)), 0.3 * np.ones(len(F))
     U, info = solve_bounded(csr_matrix(K), F, None, np.zeros(0), c, lower=lo)
-    ref = minimize(lambda x: 0.5 * x @ K @ x - F @ x, np.zeros(n), jac=lambda x: K @ x - F,
-                   bounds=list(zip(lo, c)), method="L-BFGS-B",
-                   options={"ftol": 1e-15, "gtol": 1e-12, "maxiter": 10_000})
     assert (U == lo).any() and (U == c).any()         # both bounds bind somewhere
-    np.testing.assert_allclose(U, ref.x, atol=1e-6)
+    np.testing.assert_allclose(U, _lbfgsb(K, F, np.zeros(len(F)), list(zip(lo, c))), atol=1e-6)
 
 
 def test_crossed_bounds_are_refused():

@@ -9,9 +9,10 @@ together. The coupled energy per area is :class:`.degraded_energy.PhaseFieldShel
 two-field layout (node block (u₁, u₂, u₃, υ)); its Hessian holds ∂²W/∂u∂υ = 2υ ∂W_shell/∂u.
 Each iteration is a projected Newton step (Bertsekas, SIAM J. Control Optim. 20 (1982) 221):
 with R = ∂Π/∂X, the bounds held are 𝒜 = {V_i ≥ V_prev,i − ε, R_Vi < 0} (irreversibility) ∪
-{V_i ≤ ε, R_Vi > 0} (υ ≥ 0, see :mod:`.phase_solve`); on the free unknowns (all of U and V off 𝒜) the step minimises the quadratic model subject to the
+{V_i ≤ l_i + ε, R_Vi > 0} (υ ≥ 0: l = :func:`.phase_solve.lower_bound`); on the free
+unknowns (all of U and V off 𝒜) the step minimises the quadratic model subject to the
 supports C U = t g (augmented Lagrangian, the shared :class:`ConstrainedSystem`), then V is
-projected onto 0 ≤ V ≤ V_prev and the step is backtracked (Armijo on Π) once U is feasible.
+projected onto l ≤ V ≤ V_prev and the step is backtracked (Armijo on Π) once U is feasible.
 
 *Where it converges.* The AT2 energy is convex in u and in υ separately, not jointly: past
 the onset of softening the coupled tangent on the free set is indefinite and a Newton step
@@ -21,13 +22,13 @@ pivot (its inertia, Sylvester); otherwise, or when no descent is found or the it
 solved by the staggered scheme from the same state (the study records which did it).
 Converged: the supports' residual below ``newton_tol`` of the force scale, the active set
 unchanged, and the last step below 1e-3 ``staggered_tol`` (at least :data:`V_STEP`) in V
-(dimensionless) and
-:data:`U_STEP` of max |U| in U.
+(dimensionless) and :data:`U_STEP` of max |U| in U.
 """
 from __future__ import annotations
 
 import numpy as np
 
+from .phase_solve import lower_bound
 from .staggered import StaggeredNotConverged
 
 #: Armijo constant and the smallest backtracking factor of a step
@@ -101,7 +102,7 @@ class MonolithicNewton:
 
         s, N = self.settings, self.layout.n_dofs
         upper = state.phase_nodal
-        lower = np.minimum(0.0, upper)     # υ ≥ 0, below a pre-crack's own values (phase_solve)
+        lower = lower_bound(upper)
         X = np.empty(N)
         X[self.u], X[self.v] = state.displacement_nodal.ravel(), upper
         feasible, active_before = False, None
@@ -151,8 +152,9 @@ class MonolithicNewton:
             u_max = max(np.abs(X[self.u]).max(), 1e-300)
             small_u = np.abs(step[self.u]).max() <= U_STEP * u_max
             small_v = np.abs(step[self.v]).max() <= max(1e-3 * s.staggered_tol, V_STEP)
-            same = active_before is not None and np.array_equal(held, active_before)
-            active_before = held
+            bound = held | floor
+            same = active_before is not None and np.array_equal(bound, active_before)
+            active_before = bound
             if np.linalg.norm(RU) <= s.newton_tol * scale and small_u and small_v and same:
                 return X[self.u].reshape(-1, 3), X[self.v].copy(), mu, it
         raise MonolithicNotConverged(f"monolithic Newton did not converge at factor "

@@ -111,7 +111,7 @@ class PhaseProblem:
         K = self.assembler.tangent(zero)
         K = (K + diags(self._springs)).tocsr()
         C, g = (self.C, self.g) if hold_precracks else (csr_matrix((0, K.shape[0])), np.zeros(0))
-        lower = np.minimum(0.0, upper)
+        lower = lower_bound(upper)
         if C.shape[0]:
             lower[np.unique(C.tocsr().indices)] = -np.inf
         V, info = solve_bounded(K, self._springs - R0, C, g, upper, penalty=PRECRACK_PENALTY,
@@ -122,6 +122,12 @@ class PhaseProblem:
                              "parameters and the pre-crack selectors.")
         return PhaseStep(V, self.assembler.energy(V), V == np.asarray(upper), info.iterations,
                          float(np.abs(self.C @ V - self.g).max(initial=0.0)))
+
+
+def lower_bound(upper: np.ndarray) -> np.ndarray:
+    """The nodal lower bound min(0, V_prev) of υ (module doc: V ≥ 0, except below nodal
+    values a pre-crack already left negative)."""
+    return np.minimum(0.0, np.asarray(upper, dtype=np.float64))
 
 
 def precrack_nodes(points, selectors) -> np.ndarray:

@@ -41,14 +41,17 @@ class ConstrainedSystem:
     """
 
     def __init__(self, K: csr_matrix, C: csr_matrix, penalty: float = 1e4, tol: float = 1e-10,
-                 max_iter: int = 200, backend: str = "superlu"):
+                 max_iter: int = 200, backend: str = "superlu",
+                 reuse: "ConstrainedSystem | None" = None):
         t0 = time.perf_counter()
         self.C, self.tol, self.max_iter = C, tol, max_iter
         CtC = (C.T @ C).tocsr()
         scale_c = CtC.diagonal().mean() if C.shape[0] else 0.0
         self.rho = penalty * K.diagonal().mean() / scale_c if scale_c > 0 else 0.0
         self.matrix = (K + self.rho * CtC).tocsr()     # K_ρ, for eigen-analysis
-        self.factorization = factorize(self.matrix, backend)
+        # reuse: a system that is done with (its factorisation's handle is taken over)
+        self.factorization = factorize(self.matrix, backend,
+                                       reuse.factorization if reuse is not None else None)
         self.backend = self.factorization.backend
         self._solve = self.factorization.solve
         self.negative_pivots = self.factorization.negative_pivots

@@ -94,12 +94,18 @@ class Factorization:
         raise NotImplementedError
 
 
-def factorize(A, backend: str = "superlu") -> Factorization:
+def factorize(A, backend: str = "superlu", reuse: Factorization | None = None) -> Factorization:
     """A :class:`Factorization` of the symmetric sparse matrix A with ``backend`` (module
     doc); InputError if A is singular (direct backends), ConfigError if the backend is
-    unknown or not installed."""
+    unknown or not installed. ``reuse``: a factorisation that will not be solved with again
+    (a staggered or Newton iteration's previous matrix); PARDISO takes over its handle and,
+    where the sparsity pattern is the same, skips the analysis (ordering and symbolic
+    factorisation, ~half of a factorisation), the factors being those of a fresh one."""
     name = resolve_backend(backend)
-    return {"superlu": SuperLUFactorization, "pardiso": PardisoFactorization,
+    if name == "pardiso":
+        return PardisoFactorization(A, reuse if isinstance(reuse, PardisoFactorization)
+                                    else None)
+    return {"superlu": SuperLUFactorization,
             "cg_amg": AMGConjugateGradient, "cg_ilu": ILUConjugateGradient}[name](A)
 
 
@@ -151,7 +157,7 @@ class PardisoFactorization(Factorization):
     #: by 1e-4 relative between two identical runs (threaded reductions).
     IPARM = {1: 1, 2: 2, 8: 0, 10: 13, 11: 0, 13: 0, 21: 1, 34: 2}
 
-    def __init__(self, A):
+    def __init__(self, A, reuse: "PardisoFactorization | None" = None):
         self.matrix = csr_matrix(A, dtype=float)
         n = self.matrix.shape[0]
         if n == 0 or self.matrix.shape[1] != n:
@@ -161,17 +167,34 @@ class PardisoFactorization(Factorization):
             raise InputError(f"pardiso (symmetric LDLᵀ) got a non-symmetric matrix "
                              f"(max |A − Aᵀ| = {asym:.3g}); use physics.solver=superlu.")
         self.upper = _upper_with_diagonal(self.matrix)
-        self._solver = _pardiso_solver(self.MTYPE)
+        same = reuse is not None and getattr(reuse, "_solver", None) is not None and \
+            np.array_equal(reuse.upper.indptr, self.upper.indptr) and \
+            np.array_equal(reuse.upper.indices, self.upper.indices)
         from pypardiso.pardiso_wrapper import PyPardisoError
 
         try:
-            self._solver.factorize(self.upper)
+            if same:   # the handle moves here: numerical factorisation only (phase 22)
+                self._solver, reuse._solver = reuse._solver, None
+                self._solver.remove_stored_factorization()
+                self._solver.set_phase(22)
+                self._solver._call_pardiso(self.upper, np.zeros((n, 1)))
+                self._solver.factorized_A = self.upper.copy() if self.upper.nnz <= \
+                    self._solver.size_limit_storage else \
+                    self._solver._hash_csr_matrix(self.upper)
+            else:
+                self._solver = _pardiso_solver(self.MTYPE)
+                self._solver.factorize(self.upper)
         except PyPardisoError as exc:
             raise InputError(f"{SINGULAR} (PARDISO: {exc})") from None
         self.perturbed_pivots = int(self._solver.get_iparm(14))
         self.negative_pivots = int(self._solver.get_iparm(23))
 
     def solve(self, b):
+        if self._solver is None:
+            from pointatlas.errors import PointatlasError
+
+            raise PointatlasError("this PARDISO factorisation was handed on (factorize(..., "
+                                  "reuse=)) and holds no factors any more.")
         b = np.asarray(b, dtype=float)
         x = self._solver.solve(self.upper, b)
         if self.perturbed_pivots:

@@ -5,7 +5,10 @@ The study asks the physics for its built problem (``physics.fracture_path``: the
 module imported) and follows the imposed-displacement factor t from 0 to ``max_factor`` in
 ``n_increments`` equal steps Δt. When the elastic energy drops by more than
 ``jump_fraction`` of its value within a step (a crack jumps), the step is rejected and
-halved, down to Δt · ``min_step_fraction``, where the jump is accepted; a step whose
+halved, down to Δt · ``min_step_fraction``, where the jump is accepted (above the smallest
+step the physics is given that energy floor and stops the staggered iteration at the first
+iterate below it, ``increment(..., jump_floor=)``, instead of converging a step that is
+thrown away); a step whose
 staggered iteration does not converge (it crawls at a jump) is halved too, and at the
 smallest step the path stops there: the converged increments are the results, flagged in
 ``warnings`` and ``stopped`` (the run ends ``completed_with_warnings``). After a step
@@ -234,9 +237,13 @@ class FractureStudy:
             prev = records[-1]
             dt = min(step * self.max_factor, self.max_factor - prev.factor)
             smallest = full * self.min_step_fraction * (1 + 1e-9)
+            # below this elastic energy the increment is a jump, rejected unless the step is
+            # already the smallest: the staggered iteration stops as soon as an iterate is
+            floor = (1 - self.jump_fraction) * prev.energy["elastic"] \
+                if dt > smallest and prev.energy["elastic"] > 0 else None
             try:
                 with ctx.timed("increments"):
-                    new = problem.increment(prev, prev.factor + dt)
+                    new = problem.increment(prev, prev.factor + dt, jump_floor=floor)
             except PathFollowingError as exc:   # e.g. the staggered iteration did not converge
                 if dt > smallest:   # alternate minimisation crawls at a crack jump: cut
                     step /= 2

@@ -45,7 +45,11 @@ class DegradedEnergy:
 
 
 class Linearized:
-    """½ jetᵀ H₀ jet of ``base`` (see module doc); one density part, ``elastic``."""
+    """½ jetᵀ H₀ jet of ``base`` (see module doc); one density part, ``elastic``.
+
+    H₀ does not depend on the displacement: it is evaluated once per quadrature, as the
+    point data (m, n_jet²), so that a staggered solve, which assembles the tangent and the
+    densities at every iteration, does not re-evaluate the base energy's Hessian."""
 
     density_names = ("elastic",)
 
@@ -53,12 +57,18 @@ class Linearized:
         self.base = base
         self.fields = base.fields
         self.frame_invariant = False   # invariant only under infinitesimal rigid motions
+        self.n_jet = sum(f.jet_size for f in base.fields)
+        self._cache = None             # (quadrature, its H₀ (m, n_jet²))
 
     def point_data(self, q) -> np.ndarray:
-        return self.base.point_data(q)
+        if self._cache is None or self._cache[0] is not q:
+            data = np.ascontiguousarray(self.base.point_data(q), dtype=np.float64)
+            _, _, H0 = self.base.evaluate(np.zeros((len(data), self.n_jet)), data, 2)
+            self._cache = (q, np.ascontiguousarray(H0.reshape(len(data), -1)))
+        return self._cache[1]
 
     def evaluate(self, jets, data, want):
-        _, _, H0 = self.base.evaluate(np.zeros_like(jets), data, 2)
+        H0 = data.reshape(len(jets), self.n_jet, self.n_jet)
         g = np.einsum("nij,nj->ni", H0, jets)
         dens = 0.5 * np.einsum("ni,ni->n", jets, g)[:, None]
         return dens, (g if want >= 1 else None), (H0 if want >= 2 else None)

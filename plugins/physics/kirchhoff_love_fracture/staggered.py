@@ -53,19 +53,19 @@ class FractureState:
     monolithic_iterations: int = 0
 
 
-#: cap on the Newton steps of one displacement step with the amor split (each a linear solve)
-SPLIT_NEWTON_MAX = 50
-#: a Newton step of the split smaller than this fraction of max |U|: converged
-SPLIT_NEWTON_TOL = 1e-10
-#: ... or smaller than this fraction while Π no longer decreases (relative change below
-#: SPLIT_STALL): Gauss points sitting on the kink tr ε = 0 (a neutral line) make the
-#: pieces cycle with steps this small, U being as converged as the energy can tell
-SPLIT_NEWTON_STALL_STEP, SPLIT_STALL = 1e-5, 1e-12
-
-
 class StaggeredNotConverged(PathFollowingError):
     """The staggered iteration of an increment did not reach its tolerance (the states of
     the increments before it are unaffected: a path follower may cut the step)."""
+
+
+class CrackJumped(PathFollowingError):
+    """A staggered iterate's elastic energy fell below the caller's ``jump_floor``: the crack
+    jumps within this step, and the caller (which would reject the converged increment for
+    that drop) cuts the step without waiting for the iteration to converge."""
+
+    def __init__(self, message, elastic, iteration):
+        super().__init__(message)
+        self.elastic, self.iteration = elastic, iteration
 
 
 class StaggeredProblem:
@@ -184,54 +184,40 @@ class StaggeredProblem:
         return U, mu, int(negative)
 
     def _quadratic_solve(self, K, factor):
-        """argmin ½ Uᵀ(K + springs)U − t Fᵀ U subject to C U = t g (augmented Lagrangian)."""
-        from pointatlas_solvers.augmented_lagrangian import solve_augmented
+        """argmin ½ Uᵀ(K + springs)U − t Fᵀ U subject to C U = t g (augmented Lagrangian).
+        The system of the previous call is handed on (``reuse``): every displacement step
+        has the same sparsity pattern, so PARDISO factorises without a new analysis."""
+        from pointatlas_solvers.augmented_lagrangian import ConstrainedSystem
 
         s, cons = self.settings, self.constraints
-        U, mu, _ = solve_augmented((K + self.springs).tocsr(), factor * self.F, cons.matrix,
-                                   factor * cons.rhs, s.penalty, s.constraint_tol,
-                                   backend=s.solver)
+        system = ConstrainedSystem((K + self.springs).tocsr(), cons.matrix, s.penalty,
+                                   s.constraint_tol, backend=s.solver,
+                                   reuse=getattr(self, "_last_system", None))
+        self._last_system = system
+        U, mu, _ = system.solve(factor * self.F, factor * cons.rhs)
         return U, mu
 
     def _split_newton(self, factor, U0):
-        """The minimiser of the convex, piecewise quadratic split energy (:mod:`.amor_split`):
-        semi-smooth Newton, each step the constrained minimiser of the quadratic of the
-        current piece (its tangent), backtracked (Armijo) when it does not lower Π; done when
-        a step changes U by less than SPLIT_NEWTON_TOL of max |U| (the pieces no longer
-        change), or by less than SPLIT_NEWTON_STALL_STEP while Π changes by less than
-        SPLIT_STALL of itself (cycling between pieces at the kink, see the constants)."""
-        A, f = self.assembler_u, factor * self.F
+        """The displacement step of the amor split (:func:`.split_newton.minimise_split`)."""
+        from .split_newton import minimise_split
 
-        def merit(U):
-            return A.energy(U)["total"] + 0.5 * U @ (self.springs @ U) - f @ U
+        return minimise_split(self, factor, U0)
 
-        U = np.zeros(self.layout_u.n_dofs) if U0 is None else np.asarray(U0, float).ravel()
-        feasible = False
-        for it in range(1, SPLIT_NEWTON_MAX + 1):
-            K = A.tangent(U)
-            Un, mu = self._quadratic_solve(K, factor)
-            d = Un - U
-            size = np.abs(d).max() / max(np.abs(Un).max(), 1e-300)
-            if size <= SPLIT_NEWTON_TOL:
-                return Un, mu
-            if feasible:                      # U satisfies the supports: a descent step
-                m0, slope, alpha = merit(U), float((K @ U + self.springs @ U - f) @ d), 1.0
-                while (m1 := merit(U + alpha * d)) > m0 + 1e-4 * alpha * slope \
-                        and alpha > 1e-6:
-                    alpha *= 0.5
-                if size <= SPLIT_NEWTON_STALL_STEP and abs(m0 - m1) <= SPLIT_STALL * abs(m0):
-                    return Un, mu
-                Un = U + alpha * d
-            U, feasible = Un, True
-        raise StaggeredNotConverged(
-            f"the displacement step of the amor split did not converge at imposed-displacement "
-            f"factor {factor:.6g} in {SPLIT_NEWTON_MAX} Newton steps (max |ΔU| = "
-            f"{np.abs(d).max():.3g}). Take smaller increments, or use physics.split=none.")
-
-    def increment(self, state: FractureState, factor: float) -> FractureState:
+    def increment(self, state: FractureState, factor: float,
+                  jump_floor: float | None = None) -> FractureState:
         """The converged solution at ``factor`` from ``state``: staggered (module doc), or
         first the monolithic Newton of :mod:`.monolithic` with ``scheme: monolithic``, the
-        staggered iteration taking over from the same state where that gives up."""
+        staggered iteration taking over from the same state where that gives up.
+
+        ``jump_floor`` (energy; None: no check): when the elastic energy of a staggered
+        iterate (U_k at the degradation of V_{k−1}, what the increment would report were it
+        to stop at iterate k) falls below it, :class:`CrackJumped` is raised at once. A path
+        follower that rejects increments whose elastic energy drops below a floor passes
+        it, and a step whose crack jumps costs a few iterations instead of a converged
+        staggered solve that is thrown away (at a jump the iteration takes 30–120 of them).
+        Under displacement control the iterates' elastic energy falls as the crack grows, so
+        an iterate below the floor announces a converged increment below it; were it to
+        recover, the step is only cut more finely than needed (the path stays valid)."""
         s, started = self.settings, time.perf_counter()
         if s.scheme == "monolithic":
             from .monolithic import MonolithicNewton, MonolithicNotConverged
@@ -253,6 +239,13 @@ class StaggeredProblem:
         for it in range(1, s.max_staggered + 1):
             U, mu, psi, negative = self.displacement_step(V, factor, U_warm, mu_warm)
             U_warm, mu_warm = U, mu
+            if jump_floor is not None:
+                elastic = self._iterate_elastic(U, psi)
+                if elastic < jump_floor:
+                    raise CrackJumped(
+                        f"the crack jumps at imposed-displacement factor {factor:.6g}: the "
+                        f"elastic energy of staggered iterate {it} is {elastic:.6g}, below "
+                        f"{jump_floor:.6g}.", elastic, it)
             step = self.phase.solve(psi, upper, V, hold_precracks=False)
             changes.append(float(np.abs(step.nodal - V).max()))
             V = step.nodal
@@ -266,6 +259,14 @@ class StaggeredProblem:
                 "physics.max_staggered.")
         return self._state(factor, U, V, mu, it, changes, negative, step.energy["fracture"],
                            started)
+
+    def _iterate_elastic(self, U, psi):
+        """The elastic energy of the displacement step's U at the degradation it was solved
+        with: Σ_q w_q g_q ψ_q without a split (ψ the undegraded density, all of W), the
+        assembled energy with one (ψ is then its tensile part only)."""
+        if self.settings.split == "amor":
+            return self.assembler_u.energy(U.ravel())["total"]
+        return float(self.model.quadrature.weights @ (self.energy_u.degradation * psi))
 
     def _state(self, factor, U, V, mu, it, changes, negative, fracture, started,
                monolithic=0):

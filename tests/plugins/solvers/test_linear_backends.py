@@ -91,6 +91,32 @@ def test_pardiso_takes_a_saddle_point_matrix_with_zero_diagonal():
     assert f.negative_pivots == 4
 
 
+def test_pardiso_reuses_the_analysis_of_a_matrix_of_the_same_pattern():
+    """A factorisation handed on (reuse=) gives its handle to the new one: with the same
+    pattern only the numerical phase runs, and the answers are a fresh factorisation's to
+    the last bit; the old one then refuses to solve, and another pattern gets a fresh
+    analysis."""
+    from pointatlas.errors import PointatlasError
+
+    available("pardiso")
+    A = laplacian(14) + sp.identity(14 * 14, format="csr")
+    scaled = sp.diags(np.linspace(1.0, 3.0, A.shape[0]))
+    B = (scaled @ A @ scaled).tocsr()         # same pattern, other values, still SPD
+    b = np.random.default_rng(0).standard_normal(A.shape[0])
+    first = factorize(A, "pardiso")
+    x_a = first.solve(b)
+    second = factorize(B, "pardiso", reuse=first)
+    assert second._solver is not None and first._solver is None
+    np.testing.assert_array_equal(second.solve(b), factorize(B, "pardiso").solve(b))
+    np.testing.assert_allclose(B @ second.solve(b), b, rtol=0, atol=1e-10)
+    with pytest.raises(PointatlasError, match="handed on"):
+        first.solve(b)
+    other = laplacian(10) + sp.identity(100, format="csr")
+    third = factorize(other, "pardiso", reuse=second)
+    np.testing.assert_allclose(other @ third.solve(b[:100]), b[:100], atol=1e-10)
+    np.testing.assert_allclose(x_a, spsolve(A.tocsc(), b), atol=1e-10)
+
+
 @pytest.mark.parametrize("backend", ["superlu", "pardiso"])
 def test_a_singular_matrix_is_refused(backend):
     A = sp.diags([1.0, 1.0, 0.0]).tocsr()

@@ -23,8 +23,9 @@ displacement) by the trapezoidal rule, plus the work of dead loads t Fᵀu),
 ``staggered_iterations``, ``monolithic_iterations`` (0: solved by the staggered scheme),
 ``negative_modes`` (of the displacement step's tangent), ``crack_length`` (fracture energy
 / (G_c h)),
-``min_phase_field_away`` (min υ at the points away from the pre-cracks: where the
-pre-cracks' own band leaves υ₀ ≥ 0.95 at increment 0; every point without pre-crack), and
+``min_phase_field_away`` (min υ at the points away from the pre-cracks,
+``away_from_precracks``: outside the pre-cracks' own bands at increment 0, as the physics
+defines them, ``problem.away_from_precracks``; every point without pre-crack), and
 the fields ``phase_field`` and ``displacement`` at every sampled point; the run directory
 gets ``snapshots/increment_NNNN.vtp`` (υ, u and the deformed points) of every increment.
 
@@ -90,21 +91,26 @@ class FractureStudySettings:
         "resume_from": [Types(str), None]}
 
 
-HALVES = ("min_phase_field_above", "min_phase_field_below", "other_side_min_phase_field")
+HALVES = ("min_phase_field_above", "min_phase_field_below", "other_side_min_phase_field",
+          "other_side_min_phase_field_before")
 
 
 def halves(ds, plane):
     """``min_phase_field_above`` / ``_below`` along ``increment`` (min υ away from the
-    pre-cracks on each side n·x ≷ d of ``plane``) and ``other_side_min_phase_field``: at the
-    first increment where one side has nucleated (< 0.1), the min υ on the other side (NaN
-    if neither has): near 1 when the crack starts on one side only."""
-    from .fracture_increments import AWAY, NUCLEATED
+    pre-cracks, ``away_from_precracks``, on each side n·x ≷ d of ``plane``) and
+    ``other_side_min_phase_field``: at the first increment where one side has nucleated
+    (< 0.1), the min υ on the other side (NaN if neither has): near 1 when the crack starts
+    on one side only. A crack that runs through both sides within that increment (an
+    unstable jump) leaves both low; ``other_side_min_phase_field_before`` is then the
+    telling figure: the min υ on the side that is less damaged at the nucleating increment
+    (the other side), at the increment before it."""
+    from .fracture_increments import NUCLEATED
     from .fracture_symmetry import plane_offset
 
     p = np.asarray(plane, dtype=float).ravel()
     side, _ = plane_offset(ds["position"].values, p)
     v = ds["phase_field"].values
-    away = v[0] >= AWAY
+    away = ds["away_from_precracks"].values.astype(bool)
     out = {}
     for name, mask in (("above", away & (side > 0)), ("below", away & (side < 0))):
         out[name] = v[:, mask].min(axis=1) if mask.any() else np.full(len(v), np.nan)
@@ -112,13 +118,17 @@ def halves(ds, plane):
             "units": "1", "long_name": f"min υ away from the pre-cracks {name} the plane "
                                        f"{list(map(float, p))} (n·x {'>' if name == 'above' else '<'} d)"})
     hit = np.flatnonzero(np.fmin(out["above"], out["below"]) < NUCLEATED)
-    other = float("nan")
+    other = before = float("nan")
     if hit.size:
         k = hit[0]
-        other = float(out["below"][k] if out["above"][k] < out["below"][k] else out["above"][k])
+        name = "below" if out["above"][k] < out["below"][k] else "above"
+        other = float(out[name][k])
+        before = float(out[name][k - 1]) if k > 0 else float("nan")
     ds["other_side_min_phase_field"] = ((), other, {
         "units": "1", "long_name": "min υ on the other side of the plane when one side first "
                                    "has min υ < 0.1"})
+    ds["other_side_min_phase_field_before"] = ((), before, {
+        "units": "1", "long_name": "min υ on that other side at the increment before"})
     return ds
 
 

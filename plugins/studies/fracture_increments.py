@@ -21,10 +21,6 @@ NAME = "increments.nc"
 FORMAT = "fracture-1"
 ONE = {"units": "1"}
 ENERGY = {"units": "energy"}
-#: "away from the pre-cracks": the points where the pre-cracks' own phase field (increment 0,
-#: no load) is at least this, i.e. outside their bands 1 − υ₀ > 0.05 (about 6κ̄ from a
-#: straight pre-crack, υ₀ = 1 − exp(−d/2κ̄)); with no pre-crack, every point
-AWAY = 0.95
 #: a crack has nucleated (or grown) away from the pre-cracks where min υ drops below this
 NUCLEATED = 0.1
 
@@ -52,7 +48,8 @@ def dataset(problem, records):
     s = problem.settings
     fields = [problem.point_fields(r) for r in records]
     phase = np.stack([f[0] for f in fields])
-    away = phase[0] >= AWAY      # none: the bands cover the cloud, NaN (nothing is away)
+    # outside the pre-cracks' own bands (the physics knows its band); none away: NaN
+    away = np.asarray(problem.away_from_precracks(phase[0]), dtype=bool)
     away_min = phase[:, away].min(axis=1) if away.any() else np.full(len(phase), np.nan)
     data = {
         "load_factor": (("increment",), t, {**ONE, "long_name": "imposed-displacement factor t"}),
@@ -64,7 +61,8 @@ def dataset(problem, records):
         "elastic_energy": (("increment",), [r.energy["elastic"] for r in records], {
             **ENERGY, "long_name": "degraded strain energy ∫ (υ² + η) W(u)"}),
         "fracture_energy": (("increment",), [r.energy["fracture"] for r in records], {
-            **ENERGY, "long_name": "crack energy G_c h ∫ (1−υ)²/(4κ̄) + κ̄|∇υ|²"}),
+            **ENERGY, "long_name": "regularised crack energy (at2: G_c h ∫ (1−υ)²/(4κ̄) + "
+                                   "κ̄|∇υ|²; at1: G_c h ∫ 3(1−υ)/(16κ̄) + (3κ̄/4)|∇υ|²)"}),
         "external_work": (("increment",), work, {
             **ENERGY, "long_name": "∫ reaction d(imposed displacement) (trapezoidal) + t Fᵀu"}),
         "staggered_iterations": (("increment",), [r.staggered_iterations for r in records], {
@@ -80,8 +78,12 @@ def dataset(problem, records):
                          {"long_name": "crack length as fracture energy / (G_c h)",
                           "units": "length"}),
         "min_phase_field_away": (("increment",), away_min, {
-            **ONE, "long_name": f"min υ at the points away from the pre-cracks (their own "
-                                f"band's υ ≥ {AWAY:g} at increment 0)"}),
+            **ONE, "long_name": "min υ at the points away from the pre-cracks (outside their "
+                                "own bands at increment 0: away_from_precracks)"}),
+        "away_from_precracks": (("point",), away.astype(np.int8), {
+            **ONE, "long_name": "1 where the point is outside the pre-cracks' own bands at "
+                                "increment 0 (at2: υ₀ ≥ 0.95; at1: υ₀ = 1, its band is "
+                                "compact)"}),
         "nucleation_displacement": ((), nucleation_displacement(delta, away_min), {
             "units": "length", "long_name": f"imposed displacement at which min υ away from "
                                             f"the pre-cracks first drops below {NUCLEATED:g} "

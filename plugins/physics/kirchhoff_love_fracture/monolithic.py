@@ -68,7 +68,7 @@ class MonolithicNewton:
         base = ShellEnergy(s.young_modulus, s.poisson_ratio, s.thickness)
         shell = base if s.kinematics == "nonlinear" else Linearized(base)
         crack = CrackEnergy(s.fracture_toughness, s.thickness, s.length_scale,
-                            s.residual_stiffness)
+                            s.residual_stiffness, model=s.crack_model)
         n = problem.model.nodes.shape[0]
         self.layout = FieldLayout((*base.fields, PHASE_FIELD), n)
         self.assembler = Assembler(problem.model.quadrature, self.layout,

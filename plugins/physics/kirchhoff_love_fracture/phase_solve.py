@@ -77,7 +77,8 @@ class PhaseProblem:
         self.model, self.settings = model, settings
         self.layout = FieldLayout(CrackEnergy.fields, model.nodes.shape[0])
         self.energy = CrackEnergy(settings.fracture_toughness, settings.thickness,
-                                  settings.length_scale, settings.residual_stiffness)
+                                  settings.length_scale, settings.residual_stiffness,
+                                  model=settings.crack_model)
         self.assembler = Assembler(model.quadrature, self.layout, [self.energy])
         if len(precrack_nodes):
             self.C, self.g = value_constraints(model.atlas, self.layout, "phase_field",

@@ -39,7 +39,7 @@ class KirchhoffLoveFracture:
     fields: ClassVar[tuple] = (DISPLACEMENT, PHASE_FIELD)
     description: ClassVar[str] = (
         "Phase-field brittle fracture of Kirchhoff–Love shells on the atlas: the shell energy "
-        "degraded by υ² + η, AT2 crack energy, irreversible (thesis §4, Amiri et al. 2014).")
+        "degraded by υ² + η, AT2 (or AT1) crack energy, irreversible (thesis §4, Amiri et al. 2014).")
     #: a small problem for pointatlas.testing.check_physics: the conformance patch ([0, 1]² ×
     #: [0, 0.35]) clamped on its boundary under a surface load, with a pre-crack across it
     conformance_case: ClassVar[dict] = {
@@ -80,7 +80,7 @@ class KirchhoffLoveFracture:
             raise ConfigError("physics.length_scale (κ̄) is not set: give the crack band width.")
         shell = ShellEnergy(self.young_modulus, self.poisson_ratio, self.thickness)
         crack = CrackEnergy(self.fracture_toughness, self.thickness, self.length_scale,
-                            self.residual_stiffness)
+                            self.residual_stiffness, model=self.crack_model)
         return [PhaseFieldShellEnergy(shell, crack)]
 
     def discrete_energy(self, patch: dict):

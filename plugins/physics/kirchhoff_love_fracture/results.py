@@ -5,6 +5,8 @@ import numpy as np
 
 LENGTH = "length"
 ONE = {"units": "1"}
+CRACK_ENERGY = ("regularised crack energy G_c h ∫ a w(1−υ)/κ̄ + b κ̄|∇υ|² dΩ (at2: a = ¼, "
+                "w = (1−υ)², b = 1; at1: a = 3/16, w = 1−υ, b = ¾)")
 
 
 def crack_length(fracture_energy: float, settings) -> float:
@@ -39,8 +41,7 @@ def phase_dataset(model, settings, step, phase):
     v = values_at_nodes(model.atlas, step.nodal.reshape(-1, 1), np.arange(n))[:, 0]
     Gf = float(step.energy["fracture"])
     data = {
-        "fracture_energy": ((), Gf, {"long_name": "crack energy G_c h ∫ (1−υ)²/(4κ̄) + "
-                                                  "κ̄|∇υ|² dΩ", "units": "energy"}),
+        "fracture_energy": ((), Gf, {"long_name": CRACK_ENERGY, "units": "energy"}),
         "crack_length": ((), crack_length(Gf, settings), {
             "long_name": "crack length as fracture energy / (G_c h)", "units": LENGTH}),
         "fracture_toughness": ((), float(settings.fracture_toughness), {
@@ -48,7 +49,10 @@ def phase_dataset(model, settings, step, phase):
         "thickness": ((), float(settings.thickness), {"long_name": "shell thickness h",
                                                       "units": LENGTH}),
         "length_scale": ((), float(settings.length_scale), {
-            "long_name": "phase-field length scale κ̄ (AT2 ℓ = 2κ̄)", "units": LENGTH}),
+            "long_name": "phase-field length scale κ̄ (ℓ = 2κ̄)", "units": LENGTH}),
+        "crack_model": ((), str(settings.crack_model), {
+            **ONE, "long_name": "crack energy model (at2: the thesis' quadratic, at1: linear, with an "
+                         "elastic threshold)"}),
         "max_phase_field": ((), float(v.max()), {**ONE, "long_name": "max υ at the points"}),
         "n_precrack_points": ((), len(phase.precrack_nodes), {
             **ONE, "long_name": "points held at υ = 0 by the pre-crack selectors"}),
@@ -75,7 +79,7 @@ def state_dataset(problem, state):
         "elastic_energy": ((), state.energy["elastic"], {
             "long_name": "degraded strain energy ∫ (υ² + η) W(u)", "units": "energy"}),
         "fracture_energy": ((), state.energy["fracture"], {
-            "long_name": "crack energy G_c h ∫ (1−υ)²/(4κ̄) + κ̄|∇υ|²", "units": "energy"}),
+            "long_name": CRACK_ENERGY, "units": "energy"}),
         "crack_length": ((), crack_length(state.energy["fracture"], problem.settings), {
             "long_name": "crack length as fracture energy / (G_c h)", "units": LENGTH}),
         "reaction": ((), problem.reaction(state), {

@@ -9,6 +9,10 @@ settings`, the same keys), plus the phase field (notation of the thesis §4 and 
 ``length_scale``         κ̄ (length): the band width; ℓ = 2κ̄ in the AT2 form. Must span a
                          few point spacings (:data:`MIN_SPACINGS`)
 ``residual_stiffness``   η_κ̄ in (0, 1): stiffness kept by broken material, g(0) = η_κ̄
+``crack_model``          ``at2`` (the thesis: (1 − υ)²/(4κ̄), no elastic phase: any strain
+                         energy lowers υ) or ``at1`` ((1 − υ) linear: intact, υ = 1, below
+                         the threshold ψ_c = 3G_c h/(32κ̄) of the driving energy), both with
+                         crack energy G_c h per crack length (:mod:`.phase_field`)
 ``split``                ``none`` (the thesis: all of W degraded), or ``amor``: only the
                          tensile part of the strain energy at points through the thickness
                          is degraded and drives the crack (Amor et al. 2009, Kiendl et al.
@@ -43,6 +47,7 @@ from pointatlas.errors import ConfigError
 from pointatlas_physics.kirchhoff_love.settings import ShellSettings
 
 SPLITS = ("none", "amor")
+CRACK_MODELS = ("at2", "at1")
 SCHEMES = ("staggered", "monolithic")
 KINEMATICS = ("linear", "nonlinear", "none")
 #: κ̄ must be at least this many median point spacings: below it the band 1 − υ = e^{−|x|/2κ̄}
@@ -60,6 +65,7 @@ class FractureSettings(ShellSettings):
     fracture_toughness: float = 1.0
     length_scale: Optional[float] = None
     residual_stiffness: float = 1.0e-6
+    crack_model: str = "at2"
     split: str = "none"
     thickness_points: int = 5
     precracks: List[Any] = field(default_factory=list)
@@ -75,6 +81,7 @@ class FractureSettings(ShellSettings):
         "fracture_toughness": _POSITIVE,
         "length_scale": [*_POSITIVE, None],   # None: refused with its own message (required)
         "residual_stiffness": [Interval(float, 0, 1, closed="neither")],
+        "crack_model": [Options(CRACK_MODELS)],
         "split": [Options(SPLITS)],
         "thickness_points": [Interval(int, 2, None)],
         "staggered_tol": [Interval(float, 0, 1, closed="neither")],
@@ -169,7 +176,7 @@ def check_length_scale(length_scale: float, spacing: float, name: str) -> None:
     if length_scale < smallest:
         raise ConfigError(
             f"physics.length_scale = {length_scale:g} is too small for {name}: the crack band "
-            f"(1 − υ = exp(−|x|/2κ̄)) must span at least {MIN_SPACINGS:g} point spacings "
+            f"(about ±4κ̄ wide) must span at least {MIN_SPACINGS:g} point spacings "
             f"(median spacing {spacing:.4g}), so the smallest κ̄ this cloud supports is "
             f"{smallest:.4g}. Raise physics.length_scale, or sample the surface more densely "
             f"(about {(spacing / (length_scale / MIN_SPACINGS)) ** 2:.3g}× the points).")

@@ -33,6 +33,11 @@ import numpy as np
 
 from pointatlas_solvers.increment import PathFollowingError
 
+#: outside an at2 pre-crack's band: υ₀ ≥ this (:meth:`StaggeredProblem.away_from_precracks`)
+AWAY_AT2 = 0.95
+#: outside an at1 pre-crack's (compact) band: 1 − υ₀ below this round-off
+INTACT = 1e-9
+
 
 @dataclass
 class FractureState:
@@ -305,6 +310,15 @@ class StaggeredProblem:
         s = replace(self.settings, split=split)
         validate_parameters(s, FractureSettings.parameter_constraints, prefix="physics")
         return StaggeredProblem(self.model, s, self.precrack_nodes, log=self.log)
+
+    def away_from_precracks(self, initial_phase) -> np.ndarray:
+        """(n,) bool: the points outside the pre-cracks' own bands, from υ₀ (n,) at the points
+        in the initial state (no load; every point without pre-cracks). at2's band
+        1 − υ₀ = exp(−d/2κ̄) never ends: outside it is where 1 − υ₀ < 0.05 (d ≳ 6κ̄ from a
+        straight pre-crack); at1's band is compact, 1 − υ₀ = (1 − d/4κ̄)² for d < 4κ̄:
+        outside it is where υ₀ = 1 (:data:`INTACT`, the round-off of Σ p_b = 1)."""
+        v0 = np.asarray(initial_phase, dtype=np.float64)
+        return v0 >= (1.0 - INTACT if self.settings.crack_model == "at1" else AWAY_AT2)
 
     def material(self) -> dict:
         """{young_modulus, poisson_ratio, thickness, fracture_toughness, length_scale,

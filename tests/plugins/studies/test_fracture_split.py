@@ -61,10 +61,12 @@ def test_halves_name_the_side_a_crack_starts_on_and_the_other_sides_phase_field(
                   [0.05, 0.9, 0.93, 0.98, 0.0],   # below nucleates first (0.05 < 0.1)
                   [0.0, 0.5, 0.06, 0.9, 0.0]])
     ds = xr.Dataset({"position": (("point", "dim"), x),
-                     "phase_field": (("increment", "point"), v)})
+                     "phase_field": (("increment", "point"), v),
+                     "away_from_precracks": (("point",), np.array([1, 1, 1, 1, 0], np.int8))})
     out = halves(ds, [0, 2, 0, 0])                # n·x = 0 with a non-unit normal
     np.testing.assert_array_equal(out["min_phase_field_below"].values, [1, 0.9, 0.05, 0.0])
     np.testing.assert_array_equal(out["min_phase_field_above"].values, [1, 0.97, 0.93, 0.06])
     assert float(out["other_side_min_phase_field"]) == 0.93
+    assert float(out["other_side_min_phase_field_before"]) == 0.97
     assert nucleation_displacement(np.array([0, 1.0, 2, 3]), v[:, :4].min(axis=1)) == 2.0
     assert np.isnan(nucleation_displacement(np.array([0, 1.0]), np.array([1.0, 0.5])))

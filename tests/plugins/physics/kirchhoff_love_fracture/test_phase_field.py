@@ -15,9 +15,9 @@ def _point(seed):
 
 
 @settings(max_examples=30, deadline=None)
-@given(seed=st.integers(0, 10_000))
-def test_gradient_and_hessian_match_finite_differences(seed):
-    e = CrackEnergy(2.0, 0.1, 0.05, 1e-3)
+@given(seed=st.integers(0, 10_000), model=st.sampled_from(["at2", "at1"]))
+def test_gradient_and_hessian_match_finite_differences(seed, model):
+    e = CrackEnergy(2.0, 0.1, 0.05, 1e-3, model=model)
     jet, data = _point(seed)
     _, g, H = e.evaluate(jet, data, 2)
     h = 1e-6
@@ -66,6 +66,40 @@ def test_the_band_is_the_minimiser_in_one_dimension():
     dphi = np.pi / 0.58 * np.sin(2 * np.pi * (x - 0.02) / 0.58)
     weak = np.trapezoid(g[:, 0] * phi + g[:, 1] * dphi, x)
     assert abs(weak) < 1e-8
+
+
+def test_the_at1_band_has_energy_gc_h_per_unit_length():
+    """AT1's compact band υ = 1 − (1 − |x|/4κ̄)² (|x| < 4κ̄) integrates to G_c h too, and
+    it is not AT2's: the AT2 kernel on the same profile gives another number."""
+    Gc, h, k = 3.0, 0.2, 0.07
+    e1, e2 = (CrackEnergy(Gc, h, k, 1e-6, model=m) for m in ("at1", "at2"))
+
+    def density(x, e):
+        s = max(1 - abs(x) / (4 * k), 0.0)
+        jet = np.array([[1 - s * s, np.sign(x) * 2 * s / (4 * k), 0.0]])
+        return e.evaluate(jet, np.array([[1.0, 0.0, 1.0, 0.0]]), 0)[0][0, 0]
+
+    at1 = 2 * quad(density, 0, 4 * k, args=(e1,), limit=200)[0]
+    at2 = 2 * quad(density, 0, 4 * k, args=(e2,), limit=200)[0]
+    assert abs(at1 / (Gc * h) - 1) < 1e-10
+    assert abs(at2 / (Gc * h) - 1) > 0.05
+
+
+def test_at1_has_an_elastic_threshold_and_at2_none():
+    """The homogeneous stationarity ∂W/∂υ = 0 at υ = 1: the at1 gradient at υ = 1 changes
+    sign at ψ_c = 3 G_c h/(32κ̄) (below it the bound υ ≤ 1 holds υ at 1), and above it the
+    stationary point is υ = ψ_c/ψ; at2's gradient at υ = 1 is 2ψ > 0 for every ψ > 0."""
+    Gc, h, k = 1e-3, 0.1, 0.05
+    e1, e2 = (CrackEnergy(Gc, h, k, 1e-6, model=m) for m in ("at1", "at2"))
+    psi_c = 3 * Gc * h / (32 * k)
+    assert e1.threshold() == psi_c and e2.threshold() == 0.0
+
+    def slope(e, v, psi):
+        return e.evaluate(np.array([[v, 0.0, 0.0]]), np.array([[1.0, 0.0, 1.0, psi]]), 1)[1][0, 0]
+
+    assert slope(e1, 1.0, 0.99 * psi_c) < 0 < slope(e1, 1.0, 1.01 * psi_c)
+    assert abs(slope(e1, psi_c / (2 * psi_c), 2 * psi_c)) < 1e-15
+    assert slope(e2, 1.0, 1e-3 * psi_c) > 0
 
 
 def test_degradation():

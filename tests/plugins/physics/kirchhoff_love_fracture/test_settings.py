@@ -13,6 +13,7 @@ BASE = ["experiment=fracture_crack_energy", "source.n_points=441", "physics.leng
     ("physics.residual_stiffness=0", "physics.residual_stiffness"),
     ("physics.split=amor", "physics.split=amor splits the strain energy"),
     ("physics.split=spectral", "physics.split"),
+    ("physics.crack_model=at3", "physics.crack_model"),
     ("physics.kinematics=exact", "physics.kinematics"),
     ("physics.precracks=[{box:[5,5,5,6,6,6]}]", "physics.precracks[0]"),
     ("physics.precracks=[{}]", "has no criterion"),

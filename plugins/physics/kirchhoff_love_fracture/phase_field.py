@@ -22,7 +22,7 @@ energy/length² (a toughness, J/m²), h and κ̄ length, W_υ energy/length².
 
 Crack models (``crack_model``). Both are G_c h/c_w [w(d)/ℓ + ℓ|∇υ|²] in the damage
 d = 1 − υ with ℓ = 2κ̄ (Pham, Amor, Marigo & Maurini, Int. J. Damage Mech. 20 (2011) 618;
-Tanné, Li, Bourdin, Marigo & Maurini, JMPS 110 (2018) 80, Eq. (2)):
+Tanné, Li, Bourdin, Marigo & Maurini, J. Mech. Phys. Solids 110 (2018) 80):
 
 * ``at2`` (the thesis' model above): w = d², c_w = 2. No elastic phase: any ψ > 0 lowers
   υ, homogeneously to υ = c/(c + 2ψ), c = G_c h/(2κ̄).

@@ -39,7 +39,8 @@ class KirchhoffLoveFracture:
     fields: ClassVar[tuple] = (DISPLACEMENT, PHASE_FIELD)
     description: ClassVar[str] = (
         "Phase-field brittle fracture of Kirchhoff–Love shells on the atlas: the shell energy "
-        "degraded by υ² + η, AT2 (or AT1) crack energy, irreversible (thesis §4, Amiri et al. 2014).")
+        "degraded by υ² + η, AT2 (or AT1) crack energy, irreversible (thesis §4, Amiri et al. "
+        "2014).")
     #: a small problem for pointatlas.testing.check_physics: the conformance patch ([0, 1]² ×
     #: [0, 0.35]) clamped on its boundary under a surface load, with a pre-crack across it
     conformance_case: ClassVar[dict] = {

@@ -5,8 +5,8 @@ import numpy as np
 
 LENGTH = "length"
 ONE = {"units": "1"}
-CRACK_ENERGY = ("regularised crack energy G_c h ∫ a w(1−υ)/κ̄ + b κ̄|∇υ|² dΩ (at2: a = ¼, "
-                "w = (1−υ)², b = 1; at1: a = 3/16, w = 1−υ, b = ¾)")
+CRACK_ENERGY = ("regularised crack energy G_c h ∫ a w(1−υ)/κ̄ + b κ̄|∇υ|² dΩ "
+                "(at2: a = ¼, w = (1−υ)², b = 1; at1: a = 3/16, w = 1−υ, b = ¾)")
 
 
 def crack_length(fracture_energy: float, settings) -> float:
@@ -51,8 +51,8 @@ def phase_dataset(model, settings, step, phase):
         "length_scale": ((), float(settings.length_scale), {
             "long_name": "phase-field length scale κ̄ (ℓ = 2κ̄)", "units": LENGTH}),
         "crack_model": ((), str(settings.crack_model), {
-            **ONE, "long_name": "crack energy model (at2: the thesis' quadratic, at1: linear, with an "
-                         "elastic threshold)"}),
+            **ONE, "long_name": "crack energy model (at2: the thesis' quadratic, at1: "
+                                "linear, with an elastic threshold)"}),
         "max_phase_field": ((), float(v.max()), {**ONE, "long_name": "max υ at the points"}),
         "n_precrack_points": ((), len(phase.precrack_nodes), {
             **ONE, "long_name": "points held at υ = 0 by the pre-crack selectors"}),

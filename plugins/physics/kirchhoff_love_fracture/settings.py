@@ -46,8 +46,9 @@ from pointatlas.errors import ConfigError
 
 from pointatlas_physics.kirchhoff_love.settings import ShellSettings
 
+from .phase_field import CRACK_MODELS
+
 SPLITS = ("none", "amor")
-CRACK_MODELS = ("at2", "at1")
 SCHEMES = ("staggered", "monolithic")
 KINEMATICS = ("linear", "nonlinear", "none")
 #: κ̄ must be at least this many median point spacings: below it the band 1 − υ = e^{−|x|/2κ̄}
@@ -81,7 +82,7 @@ class FractureSettings(ShellSettings):
         "fracture_toughness": _POSITIVE,
         "length_scale": [*_POSITIVE, None],   # None: refused with its own message (required)
         "residual_stiffness": [Interval(float, 0, 1, closed="neither")],
-        "crack_model": [Options(CRACK_MODELS)],
+        "crack_model": [Options(tuple(CRACK_MODELS))],
         "split": [Options(SPLITS)],
         "thickness_points": [Interval(int, 2, None)],
         "staggered_tol": [Interval(float, 0, 1, closed="neither")],

@@ -1,0 +1,1 @@
+"""Axisymmetric Stokes boundary elements: ring kernels, generating curves, self-propulsion."""

@@ -6,14 +6,16 @@ distance r₀ from the axis reduces to these moments with
     a = r² + r₀² + (z − z₀)²,   b = 2 r r₀,   a − b cos φ = |x₀ − y(φ)|²
 
 (Pozrikidis 1992, §2.4 and §6.1; here derived from scratch). With the parameter of the
-complete elliptic integrals m = k² = 2b/(a + b) (``scipy.special.ellipk/ellipe`` take m):
+complete elliptic integrals m = k² = 2b/(a + b) (``scipy.special.ellipk/ellipe`` take m),
+the moments without powers of cos φ, L_{0,m} = ∫ ρ^{−m} dφ, are
 
-    I_{0,−1} = 4 √(a+b) E(m),          I_{0,1} = 4 K(m) / √(a+b),
-    I_{0,3}  = 4 E(m) / ((a−b) √(a+b)),
-    I_{0,5}  = 8 / (3 (a−b) (a+b)^{3/2}) · (2a E(m)/(a−b) − K(m)/2)
+    L_{0,−1} = 4 √(a+b) E(m),          L_{0,1} = 4 K(m) / √(a+b),
+    L_{0,3}  = 4 E(m) / ((a−b) √(a+b)),
+    L_{0,5}  = 8 / (3 (a−b) (a+b)^{3/2}) · (2a E(m)/(a−b) − K(m)/2)
 
-(I_{0,5} = −(2/3) ∂I_{0,3}/∂a, with dE/dm = (E − K)/(2m), dK/dm = (E − (1−m)K)/(2m(1−m))).
-and L_{0,m} = I_{0,m}. Powers of u = 1 − cos φ follow from u = (ρ² − (a − b))/b:
+(L_{0,5} = −(2/3) ∂L_{0,3}/∂a, with dE/dm = (E − K)/(2m) and
+dK/dm = (E − (1−m)K)/(2m(1−m))). Powers of u = 1 − cos φ follow from
+u = (ρ² − (a − b))/b:
 
     L_{n,m} = (L_{n−1,m−2} − (a − b) L_{n−1,m}) / b.
 
@@ -26,8 +28,9 @@ b/a → 0 (the ring or the field point near the axis, where the moments tend to 
 limits 2π⟨u^n⟩ a^{−m/2}). Where m < ``M_SWITCH`` the
 integrand is analytic in a strip of half-width arccosh(a/b) and the periodic trapezoidal rule
 with N points converges geometrically (error ~ q^N, q = (a − √(a²−b²))/b: q < 0.18 at
-m < 0.5 with N = 24, q < 0.027 at m < 0.1 with N = 12, both below 1e-17): that branch is used there, the closed forms elsewhere,
-including the logarithmically singular limit m → 1 of the self-element.
+m < 0.5 with N = 24, q < 0.027 at m < 0.1 with N = 12, both below 1e-17): that branch is
+used there, the closed forms elsewhere, including the logarithmically singular limit m → 1
+of the self-element.
 """
 from __future__ import annotations
 

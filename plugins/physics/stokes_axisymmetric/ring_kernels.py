@@ -1,19 +1,21 @@
 """Ring kernels: the free-space Stokeslet and stresslet integrated over the azimuth.
 
-A ring of radius r at height z (the source point y on the generating curve) acts on a field
-point x₀ = (r₀, 0, z₀). With d = x₀ − y(φ) = (r₀ − r cos φ, −r sin φ, z₀ − z), ρ = |d|, the
-azimuthal moments L_{n,m} = ∫ uⁿ/ρ^m dφ of :mod:`.azimuthal_moments` (u = 1 − cos φ,
-a = r² + r₀² + Δz², b = 2 r r₀) and the differences Δr = r₀ − r, Δz = z₀ − z, every kernel is
-∫_0^{2π} (polynomial in u) / ρ^m · r dφ (r dφ: the ring's arclength). Components are
-cylindrical: radial (r), axial (z) and azimuthal (φ), each in the local basis at its point.
-In u: d·e_r(x₀) = Δr + r u, d·e_r(y) = Δr − r₀ u, d·e_φ(y) = −r₀ sin φ, sin²φ = 2u − u².
+A ring of radius r at height z (the source point y on the generating curve) acts on a
+field point x₀ = (r₀, 0, z₀). With d = x₀ − y(φ) = (r₀ − r cos φ, −r sin φ, z₀ − z),
+ρ = |d|, the azimuthal moments L_{n,m} = ∫ uⁿ/ρ^m dφ of :mod:`.azimuthal_moments`
+(u = 1 − cos φ, a = r² + r₀² + Δz², b = 2 r r₀) and the differences Δr = r₀ − r,
+Δz = z₀ − z, every kernel is ∫_0^{2π} (polynomial in u) / ρ^m · r dφ (r dφ: the ring's
+arclength). Components are cylindrical: radial (r), axial (z) and azimuthal (φ), each in
+the local basis at its point. In u: d·e_r(x₀) = Δr + r u, d·e_r(y) = Δr − r₀ u,
+d·e_φ(y) = −r₀ sin φ, sin²φ = 2u − u².
 
 Single layer (Stokeslet G_ij = δ_ij/ρ + d_i d_j/ρ³, Pozrikidis 1992 Eq. 2.2.8; velocity
 u(x₀) = (1/8πμ) ∫ M f dℓ, f the force density per unit area):
 
     M_rr = r [L_{0,1} − L_{1,1} + Δr² L_{0,3} − Δr² L_{1,3} − r r₀ L_{2,3}]
-    M_rz = r Δz (Δr L_{0,3} + r L_{1,3}),   M_zr = r Δz (Δr L_{0,3} − r₀ L_{1,3})
-    M_zz = r (L_{0,1} + Δz² L_{0,3}),        M_φφ = r [L_{0,1} − L_{1,1} + r r₀ (2L_{1,3} − L_{2,3})]
+    M_rz = r Δz (Δr L_{0,3} + r L_{1,3}),    M_zr = r Δz (Δr L_{0,3} − r₀ L_{1,3})
+    M_zz = r (L_{0,1} + Δz² L_{0,3}),
+    M_φφ = r [L_{0,1} − L_{1,1} + r r₀ (2L_{1,3} − L_{2,3})]
 
 The swirl (φ) decouples from the meridional (r, z) problem. Near the ring (ρ_m → 0 in the
 meridian plane) M_rr, M_zz ~ −2 ln ρ_m and M_φφ ~ −4 ln ρ_m (a straight line of Stokeslets).
@@ -87,8 +89,8 @@ def _factors(x0, y, normal):
     nr, nz = normal[..., 0], normal[..., 1]
     zero = np.zeros_like(dz)
     return dict(r0=r0, r=r, L=L, dn=_lin(nr * dr + nz * dz, -nr * r0), d_r=_lin(dr, r),
-                e_r_y=_lin(dr, -r0), d_z=_lin(dz, zero), s2=_lin(zero, 2.0 + zero, -1.0 + zero),
-                c=3.0 * r / (4.0 * np.pi))
+                e_r_y=_lin(dr, -r0), d_z=_lin(dz, zero),
+                s2=_lin(zero, 2.0 + zero, -1.0 + zero), c=3.0 * r / (4.0 * np.pi))
 
 
 def double_layer(x0, y, normal):

@@ -126,3 +126,17 @@ class Meridian:
             raise InputError(f"{values.shape[0]} nodal values for a generating curve of "
                              f"{len(self.nodes)} nodes; give one per node.")
         return mirrored_spline(self.t_nodes, values, parity)
+
+
+def sample_bspline(curve, velocity=None, n: int = 257):
+    """(nodes (n, 2), velocities (n, 3) or None) of a generating curve given as a scipy
+    ``BSpline`` of (r, z) (and its velocity as a ``BSpline`` of (v_r, v_z, v_φ) on the same
+    parameter), sampled at n parameter values uniform over the curve's base interval."""
+    k = curve.k
+    lo, hi = curve.t[k], curve.t[-k - 1]
+    u = np.linspace(lo, hi, n)
+    nodes = np.asarray(curve(u), dtype=np.float64)
+    if velocity is None:
+        return nodes, None
+    return nodes, np.asarray(velocity(u), dtype=np.float64)
+

@@ -4,7 +4,9 @@ boundary elements (single layer for the total traction, double layer for the ext
 ``solve(ctx, shapes=…, velocities=…, times=None, motion="free")``:
 
 * ``shapes`` (n, 2) or (K+1, n, 2): generating curves as (r, z) nodes, top pole first
-  (:mod:`.meridian`); ``velocities`` the same with (v_r, v_z, v_φ) at each node.
+  (:mod:`.meridian`); ``velocities`` the same with (v_r, v_z, v_φ) at each node. One shape
+  may also be a scipy ``BSpline`` of (r, z) with its velocity a ``BSpline`` of
+  (v_r, v_z, v_φ) on the same parameter.
 * ``motion="prescribed"``: the velocities are the whole surface motion (a towed or spun
   body); the Dataset gives the axial force and torque on the fluid.
 * ``motion="free"``: the velocities are the shape change (and tangential or swirl motion) in
@@ -89,11 +91,16 @@ class StokesAxisymmetric:
         if motion not in ("free", "prescribed"):
             raise ConfigError(f"motion={motion!r}: use 'free' (self-propelled) or "
                               f"'prescribed' (towed or spun).")
+        from scipy.interpolate import BSpline
+
         disc, perm = self._discretisation(), self.permeation == "uniform"
-        X, V = np.asarray(shapes, dtype=np.float64), np.asarray(velocities, dtype=np.float64)
         log = getattr(ctx, "log", None)
+        if isinstance(shapes, BSpline):          # one shape given as a B-spline of (r, z)
+            X, V = [shapes], [velocities]
+        else:
+            X, V = np.asarray(shapes, dtype=np.float64), np.asarray(velocities, dtype=np.float64)
         if times is None:
-            if X.ndim == 2:
+            if getattr(X, "ndim", 3) == 2:
                 X, V = X[None], V[None]
             solved = [solve_one(x, v, self.viscosity, disc, motion == "free", perm)
                       for x, v in zip(X, V)]

@@ -19,11 +19,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.interpolate import BSpline
 
 from pointatlas.errors import InputError
 
 from .boundary_elements import discretise
-from .meridian import Meridian
+from .meridian import Meridian, sample_bspline
 from .self_propulsion import ShapeSolution, SingleLayerSolver, solve_shape
 
 
@@ -63,7 +64,11 @@ class StrokeSolution:
 def solve_one(nodes, velocity, mu: float, disc: Discretisation, free: bool = True,
               permeation: bool = True) -> tuple:
     """(Elements, ShapeSolution) of one shape (nodes (n, 2)) with nodal surface velocity
-    (n, 3) as (v_r, v_z, v_φ), length/time."""
+    (n, 3) as (v_r, v_z, v_φ), length/time. ``nodes`` may also be a scipy ``BSpline`` of
+    (r, z), with ``velocity`` one of (v_r, v_z, v_φ) on the same parameter
+    (:func:`.meridian.sample_bspline`, 4 samples per element, at least 257)."""
+    if isinstance(nodes, BSpline):
+        nodes, velocity = sample_bspline(nodes, velocity, max(257, 4 * disc.n_elements + 1))
     m = Meridian(nodes)
     v = np.asarray(velocity, dtype=np.float64)
     if v.shape != (len(m.nodes), 3):

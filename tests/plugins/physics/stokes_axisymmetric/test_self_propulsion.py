@@ -97,3 +97,18 @@ def test_a_wrong_velocity_array_is_refused():
     nodes = spheroid()
     with pytest.raises(InputError, match=r"give \(v_r, v_z, v_φ\) at each"):
         solve_one(nodes, np.zeros((len(nodes), 2)), MU, Discretisation(16))
+
+
+def test_a_generating_curve_given_as_a_bspline():
+    """A user's B-spline (scipy's own interpolant of an ellipse, not this code's splines):
+    the same drag as the points it was built from."""
+    from scipy.interpolate import make_interp_spline
+
+    th = np.linspace(0, np.pi, 41)
+    P = np.column_stack([np.sin(th), 2.0 * np.cos(th)])
+    curve = make_interp_spline(th, P, k=3)
+    vel = make_interp_spline(th, rigid(P, U=1.0), k=3)
+    _, s = solve_one(curve, vel, MU, Discretisation(64), free=False)
+    from pointatlas_studies.stokes_swimming import spheroid_drag
+
+    assert s.force == pytest.approx(spheroid_drag(MU, 1.0, 2.0, 1.0), rel=1e-4)

@@ -54,3 +54,19 @@ def test_efficiency_of_a_steady_squirmer_stroke_is_one_half():
                       Discretisation(64))
     assert sol.mean_speed == pytest.approx(2 / 3, rel=1e-5)
     assert sol.efficiency(sol.mean_power_out) == pytest.approx(0.5, rel=1e-4)
+
+
+@pytest.mark.parametrize("radial, tangential", [
+    ({2: 1.0}, {3: 1j}),                                # a radial and a tangential mode
+    ({1: 0.5, 2: 1j}, {1: 0.3, 2: -0.4}),               # with first-order swimming
+])
+def test_small_amplitude_strokes_against_the_second_order_theory(radial, tangential):
+    """X(T)/ε² of the boundary elements against ε² Ū₂ T of the reciprocal-theorem theory
+    (pointatlas_studies.squirming_sphere_theory: Lamb's solution, an independent code)."""
+    from pointatlas_studies.squirming_sphere_theory import second_order_mean_velocity
+
+    eps = 0.01
+    t, X, V = mm.small_amplitude_stroke(1.0, 129, 24, eps, radial, tangential)
+    sol = swim_stroke(t, X, V, 1.0, Discretisation(48))
+    theory = second_order_mean_velocity(radial, tangential, a=1.0, omega=2 * np.pi) * 1.0
+    assert sol.position[-1] / eps ** 2 == pytest.approx(theory, rel=1e-3)

@@ -128,6 +128,12 @@ def check_source(cls: type, **kwargs: Any) -> None:
     check_contract(cls)
     a = cls(**kwargs).load(np.random.default_rng(1))
     b = cls(**kwargs).load(np.random.default_rng(1))
+    if hasattr(a, "frames") and hasattr(a, "times"):       # a frame source (images + times)
+        assert np.isfinite(a.frames).all() and np.isfinite(a.times).all(), (
+            f"{cls.__name__}.load returned non-finite frames or times")
+        np.testing.assert_array_equal(a.frames, b.frames, err_msg=(
+            f"{cls.__name__}: the same rng seed must give the same frames"))
+        return
     assert isinstance(a, PointCloud), f"{cls.__name__}.load must return a PointCloud"
     assert np.isfinite(a.points).all(), f"{cls.__name__}.load returned non-finite points"
     np.testing.assert_array_equal(a.points, b.points, err_msg=(

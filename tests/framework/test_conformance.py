@@ -7,6 +7,8 @@ from pointatlas.testing import check_contract, check_plugin
 
 SMALL = {
     ("source", "file"): None,  # needs a file: built in the test below
+    ("source", "frames"): None,  # needs images: built in the test below
+    ("source", "synthetic_metaboly"): {"n_frames": 4, "image_size": 256, "pixel_size": 0.4},
     ("source", "connected_pipes"): {"n_points": 400},
     ("source", "open_pipes"): {"n_points": 600},
     ("embedder", "nlie"): {"n_stress_neighbors": 15, "max_iter": 10, "lbfgs_max_iter": 50},
@@ -26,7 +28,13 @@ def test_plugin_conforms(family, name, cls, tmp_path):
     if (family, name) == ("source", "file"):
         np.savez(tmp_path / "p.npz", points=np.random.default_rng(0).random((50, 3)))
         kwargs = {"path": str(tmp_path / "p.npz")}
-    if family == "source" and "n_points" not in kwargs and name != "file":
+    if (family, name) == ("source", "frames"):
+        import imageio.v2 as imageio
+
+        for k in range(3):
+            imageio.imwrite(tmp_path / f"f{k}.png", np.full((16, 16), 40 * k, np.uint8))
+        kwargs = {"path": str(tmp_path), "frame_rate": 2.0, "pixel_size": 0.5}
+    if family == "source" and not kwargs and name not in ("file", "frames"):
         kwargs = {"n_points": 300}
     if family == "approximant":
         kwargs = {"reproduces_linear": (family, name) in LINEAR}

@@ -7,9 +7,12 @@ a cycle starts where y₁ rises through its median after having been below
 median − ``hysteresis`` × range (crossing times interpolated linearly between frames), so
 noise near the level does not start spurious cycles. The area swept per cycle by the
 time-ordered embedding, relative to that of a circle of the same extent in y₁ (π/4 range²),
-says whether the stroke is a loop (≈ 1) or a back-and-forth arc (≈ 0; ``loop`` below 0.1). Each frame's phase is its time fraction within its cycle — the time
-reparametrisation τ(t) that merges cycles of unequal duration into one average stroke
-(frames of the partial cycles at both ends use the mean period).
+says whether the stroke is a loop (≈ 1) or a back-and-forth arc (≈ 0; ``loop`` below 0.1).
+On an arc each frame's phase is its time fraction within its cycle (frames of the partial
+cycles at both ends use the mean period). On a loop the angle of the embedding about its
+centre labels the shape; the time reparametrisation τ maps it to the mean, over the complete
+cycles, of the time fraction reached at that angle, which merges cycles of unequal duration
+into one average stroke.
 
 The smooth stroke: local max-ent (LME) basis functions p_a(φ) on ``n_bins`` periodic nodes
 φ_a = a/n_bins (the nodes copied at φ_a ± 1 and their basis functions folded back), and nodal

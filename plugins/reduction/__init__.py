@@ -1,0 +1,1 @@
+"""Lagrangian model reduction on slow manifolds learnt from snapshots (thesis §5)."""

@@ -229,7 +229,7 @@ class Frames:
             raise InputError(f"{path} is empty (0 bytes); check that it was copied completely.")
         images = path.is_dir() or path.suffix.lower() in IMAGE_SUFFIXES
         if images and self.frame_rate is None:
-            raise ConfigError(f"frame_rate is missing: images do not say their frame rate; give "
+            raise ConfigError("frame_rate is missing: images do not say their frame rate; give "
                               "source.frame_rate=<frames per second>, e.g. 10.")
         if not images:
             open_video(path).close()    # ffmpeg reads the header: refused before any work

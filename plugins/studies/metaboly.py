@@ -55,10 +55,6 @@ class MetabolySettings:
         "max_area_deviation": [Interval(float, 0, None, closed="neither")]}
 
 
-def _var(ds, name, dims, values, long_name, units="1"):
-    ds[name] = (dims, values, {"long_name": long_name, "units": units})
-
-
 @stores_config
 class Metaboly:
     """Frames of an axisymmetric cell → stroke, pellicle shear and swimming (module doc)."""

@@ -88,7 +88,6 @@ def find_cycles(Y: np.ndarray, times: np.ndarray, hysteresis: float = 0.25) -> C
         phase = _geometric_phase(y, t, starts, phase)
     out = np.empty_like(phase)
     out[order] = phase
-    n = len(starts) - 1
     return Cycles(starts, period, out, winding, loop=loop)
 
 

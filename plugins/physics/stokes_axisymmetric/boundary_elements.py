@@ -144,7 +144,6 @@ def double_layer_rhs(el: Elements, velocity, n_singular: int = 16) -> np.ndarray
     """PV ∫ T_ijk v_j n_k dS at the collocation points, (n, 3) as (r, z, φ), for the nodal
     velocity spline ``velocity`` (t → (v_r, v_z, v_φ)); by subtraction of v(x_i) and the
     identity ∫ T_ijk n_k dS = −½ δ_ij on the surface (:mod:`.ring_kernels`)."""
-    n = el.n
     v0 = velocity(el.t_mid)                                                  # (n, 3)
 
     def integrand(xi, v0i, x, nq, v):

@@ -20,7 +20,8 @@ def _physics_experiments():
     for path in sorted(EXPERIMENTS.glob("*.yaml")):
         text = path.read_text()
         if ("override /physics:" in text and path.stem not in REFUSED
-                and "override /physics: stokes_axisymmetric" not in text):  # no cloud: BEM
+                and "override /physics: stokes_axisymmetric" not in text   # no cloud: BEM
+                and "override /source: null" not in text):                 # no cloud at all
             yield path.stem
 
 

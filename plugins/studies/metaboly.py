@@ -119,6 +119,8 @@ class Metaboly:
                 truth = self._truth(ctx, seq, proc, shapes, phases, cycles)
         ds = build_dataset(seq, proc, desc, Y, Y3, cycles, phases, shapes, kin, hyd, truth)
         ds.attrs["title"] = f"metaboly of {seq.name}"
+        if ds.attrs.get("warnings"):
+            ctx.log.warning("%s", ds.attrs["warnings"])
         ctx.log.info("U = %.4g body lengths per stroke, Δθ/2π = %.4g, γ_max = %.3g, Eff_L out "
                      "%.3g %%, out+inn %.3g %%", float(ds["displacement_per_stroke"]),
                      float(ds["net_rotation"]), float(ds["shear_max"]),

@@ -109,6 +109,11 @@ def build_dataset(seq, proc, desc, Y, Y3, cycles, phases, shapes, kin, hyd, trut
         if k.startswith("mean_power"):
             units = hyd[k].attrs.get("units", ONE)
         ds[k] = _v((), val, long, units)
+    ds["reference_not_realisable"] = _v((), int(kin.not_realisable), "material nodes where "
+                                        "the canonical reference pellicle (SI Eq. S9) has no "
+                                        "real solution (clipped)")
+    if kin.warnings:                 # the pellicle's own checks: the run is flagged, not passed
+        ds.attrs["warnings"] = "pellicle kinematics: " + "; ".join(kin.warnings)
     counts = proc.get("counts", {})
     ds.attrs["dropped_by_reason"] = str(counts.get("dropped_by_reason", {}))
     return ds

@@ -2,25 +2,32 @@
 CMAME 261–262 (2013) 118, §3).
 
 Snapshots x_i ∈ R^D with embedding coordinates q_i ∈ R^d (any embedder). The embedding is
-binned on a grid of ``n_bins`` cells per coordinate; the mean q of the snapshots in each
-non-empty cell is a node q_a, and the vertices of the embedding's convex hull are nodes too
+binned on a grid of square cells, ``n_bins`` along the longest side; the mean q of the
+snapshots in each non-empty cell is a node q_a, and the vertices of the embedding's convex hull are nodes too
 (the bin means alone would leave the outermost snapshots outside the basis' domain).
 Snapshots the basis still cannot reach (on the hull's boundary, where the LME dual has no
 solution) are left out of the fit and counted (``n_unfitted_``). Local max-ent basis
-functions p_a(q) on the nodes (the ``approximant`` plugin) parametrise the manifold, X(q) = Σ_a p_a(q) P_a, with the nodal
-configurations P_a the least-squares fit to the snapshots,
+functions p_a(q) on the nodes (the ``approximant`` plugin) parametrise the manifold,
+X(q) = Σ_a p_a(q) P_a, with the nodal configurations P_a the least-squares fit to the snapshots,
 
     min_P Σ_i |Σ_a p_a(q_i) P_a − x_i|²  (+ a ridge of 1e-10 × mean diagonal),
 
 so DX(q) = Σ ∇p_a ⊗ P_a and D²X(q) = Σ ∇∇p_a ⊗ P_a follow from the basis derivatives. The
 projection q(x) of a configuration is the closest point, min_q |X(q) − x|², by Gauss–Newton
-from the embedding coordinate of the nearest snapshot (Appendix B).
+with a line search from the embedding coordinate of the nearest snapshot (Appendix B). X(q)
+is defined only inside the nodes' convex hull: evaluating it outside raises
+:class:`OutsideRegion`.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from pointatlas.errors import InputError
+from pointatlas.errors import InputError, PointatlasError
+
+
+class OutsideRegion(PointatlasError):
+    """X(q) was asked for at a q outside the sampled region (the LME nodes' convex hull),
+    where the slow manifold is not defined."""
 
 
 def hull_vertices(Q: np.ndarray) -> np.ndarray:
@@ -33,12 +40,15 @@ def hull_vertices(Q: np.ndarray) -> np.ndarray:
 
 
 def binned_nodes(Q: np.ndarray, n_bins: int) -> np.ndarray:
-    """Mean of the points of each non-empty cell of an n_bins^d grid over the box of Q."""
+    """Mean of the points of each non-empty cell of a grid of square (cubic) cells over the
+    box of Q, ``n_bins`` cells along its longest side (so the nodes are spaced alike in every
+    direction, as the LME locality β = γ/h² assumes)."""
     Q = np.asarray(Q, dtype=np.float64)
     lo, hi = Q.min(axis=0), Q.max(axis=0)
-    cell = np.minimum(((Q - lo) / np.where(hi > lo, hi - lo, 1.0) * n_bins).astype(int),
-                      n_bins - 1)
-    key = np.ravel_multi_index(cell.T, (n_bins,) * Q.shape[1])
+    h = max(float(np.max(hi - lo)), 1e-300) / n_bins
+    shape = tuple(int(k) for k in np.maximum(np.ceil((hi - lo) / h), 1))
+    cell = np.minimum(((Q - lo) / h).astype(int), np.array(shape) - 1)
+    key = np.ravel_multi_index(cell.T, shape)
     uniq, inv = np.unique(key, return_inverse=True)
     sums = np.zeros((len(uniq), Q.shape[1]))
     np.add.at(sums, inv, Q)
@@ -60,7 +70,9 @@ class SlowManifold:
         if Q.shape[1] >= len(X):
             raise InputError(f"embedding dimension {Q.shape[1]} is not below the number of "
                              f"snapshots {len(X)}; lower n_components or add snapshots.")
-        self.nodes_ = np.concatenate([binned_nodes(Q, self.n_bins), hull_vertices(Q)])
+        # a hull vertex alone in its cell is its own bin mean: keep each node once
+        self.nodes_ = np.unique(np.concatenate([binned_nodes(Q, self.n_bins),
+                                                hull_vertices(Q)]), axis=0)
         if hasattr(self.approximant, "outside"):
             self.approximant.outside = "flag"
         self.basis_ = self.approximant.fit(self.nodes_)
@@ -72,7 +84,7 @@ class SlowManifold:
         A = (B.T @ B).toarray()
         A += self.ridge * np.trace(A) / len(A) * np.eye(len(A))
         self.P_ = np.linalg.solve(A, B.T @ X)                     # (n_nodes, D)
-        self.X_, self.Q_ = X, Q
+        self.X_, self.Q_, self._sq_ = X, Q, None
         self.residual_ = float(np.sqrt(np.mean(np.sum((B @ self.P_ - X) ** 2, axis=1))))
         return self
 
@@ -84,6 +96,11 @@ class SlowManifold:
         """(X (m, D), DX (m, D, d) if order ≥ 1, D²X (m, D, d, d) if order ≥ 2) at q (m, d)."""
         q = np.atleast_2d(np.asarray(q, dtype=np.float64))
         b = self.basis_.evaluate(q, order=order)
+        if b.outside is not None and np.any(b.outside):
+            i = int(np.flatnonzero(b.outside)[0])
+            raise OutsideRegion(f"q = {np.round(q[i], 6).tolist()} lies outside the slow "
+                                f"manifold's sampled region (the convex hull of its "
+                                f"{len(self.nodes_)} LME nodes)")
         n = len(self.nodes_)
         out = [b.to_csr(n) @ self.P_]
         if order >= 1:
@@ -102,16 +119,39 @@ class SlowManifold:
             out.append(H)
         return tuple(out) if order else out[0]
 
-    def project(self, x, tol: float = 1e-12, max_iter: int = 50):
-        """(q, distance): the closest point of the manifold to x (D,) (Gauss–Newton)."""
+    def contains(self, q) -> bool:
+        """Whether X is defined at q (d,): inside the LME nodes' convex hull."""
+        b = self.basis_.evaluate(np.atleast_2d(np.asarray(q, dtype=np.float64)), order=0)
+        return b.outside is None or not bool(np.any(b.outside))
+
+    def nearest(self, x) -> int:
+        """Index of the training snapshot nearest to x (one matrix-vector product)."""
+        if getattr(self, "_sq_", None) is None:
+            self._sq_ = np.einsum("ij,ij->i", self.X_, self.X_)
+        return int(np.argmin(self._sq_ - 2.0 * (self.X_ @ x)))
+
+    def project(self, x, tol: float = 1e-6, max_iter: int = 20):
+        """(q, distance): the closest point of the manifold to x (D,) (Appendix B): Gauss–Newton
+        from the nearest snapshot's q with a backtracking line search (a step is halved until
+        it stays in the sampled region and lowers |X(q) − x|); stops when the step is below
+        ``tol`` relative to 1 + |q| or no step lowers the distance."""
         x = np.asarray(x, dtype=np.float64)
-        q = self.Q_[np.argmin(np.sum((self.X_ - x) ** 2, axis=1))].copy()
+        q = self.Q_[self.nearest(x)].copy()
+        X, DX = self.evaluate(q[None], order=1)
+        r = float(np.linalg.norm(X[0] - x))
         for _ in range(max_iter):
-            X, DX = self.evaluate(q[None], order=1)
-            r = X[0] - x
-            J = DX[0]
-            step = np.linalg.lstsq(J, -r, rcond=None)[0]
-            q += step
+            step = np.linalg.lstsq(DX[0], x - X[0], rcond=None)[0]
+            for _ in range(10):
+                if self.contains(q + step):
+                    Xn = self.evaluate((q + step)[None])[0]
+                    rn = float(np.linalg.norm(Xn - x))
+                    if rn <= r:
+                        break
+                step *= 0.5
+            else:
+                break
+            q, r = q + step, rn
             if np.linalg.norm(step) < tol * (1 + np.linalg.norm(q)):
                 break
-        return q, float(np.linalg.norm(self.evaluate(q[None])[0] - x))
+            X, DX = self.evaluate(q[None], order=1)
+        return q, r

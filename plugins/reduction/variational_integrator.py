@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pointatlas.errors import PointatlasError
+from pointatlas_reduction.slow_manifold import OutsideRegion
 
 
 class StepFailure(PointatlasError):
@@ -86,6 +87,14 @@ def _step_alpha(terms, q, p, dt, alpha, tol, max_newton):
     return None
 
 
+def _left(err, t, out_t, out_q, out_p) -> StepFailure:
+    return StepFailure(f"the reduced trajectory left the slow manifold's sampled region at "
+                       f"t = {t:.6g} ({err}); the {len(out_t)} states reached are kept. "
+                       f"Sample a wider region (more or longer training trajectories) or "
+                       f"start closer to its centre.",
+                       (np.array(out_t), np.array(out_q), np.array(out_p)))
+
+
 def energy(terms, q, p) -> float:
     """H = ½ pᵀ M̃(q)⁻¹ p + Ṽ(q)."""
     T = terms(q)
@@ -104,8 +113,11 @@ def integrate(terms, q0, v0, dt: float, n_steps: int, alpha: float = 0.0,
     for k in range(1, n_steps + 1):
         h, done, its = dt, 0.0, 0
         while done < dt - 1e-15 * dt:
-            step = (_step_alpha0(terms, q, p, h, tol, max_newton) if alpha == 0.0 else
-                    _step_alpha(terms, q, p, h, alpha, tol, max_newton))
+            try:
+                step = (_step_alpha0(terms, q, p, h, tol, max_newton) if alpha == 0.0 else
+                        _step_alpha(terms, q, p, h, alpha, tol, max_newton))
+            except OutsideRegion as err:
+                raise _left(err, t + done, out_t, out_q, out_p) from None
             if step is None:
                 if h < dt / 2 ** max_cuts:
                     states = (np.array(out_t), np.array(out_q), np.array(out_p))
@@ -122,10 +134,14 @@ def integrate(terms, q0, v0, dt: float, n_steps: int, alpha: float = 0.0,
             its += it
         t += dt
         if k % save_every == 0 or k == n_steps:
+            try:
+                e = energy(terms, q, p)
+            except OutsideRegion as err:
+                raise _left(err, t, out_t, out_q, out_p) from None
             out_t.append(t)
             out_q.append(q.copy())
             out_p.append(p.copy())
-            out_e.append(energy(terms, q, p))
+            out_e.append(e)
             out_it.append(its)
     return Trajectory(np.array(out_t), np.array(out_q), np.array(out_p), np.array(out_e),
                       np.array(out_it))

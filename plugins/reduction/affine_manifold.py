@@ -8,6 +8,8 @@ import numpy as np
 
 
 class AffineManifold:
+    is_affine = True
+
     def __init__(self, mean, components):
         self.mean = np.asarray(mean, dtype=np.float64)
         self.P = np.atleast_2d(np.asarray(components, dtype=np.float64))

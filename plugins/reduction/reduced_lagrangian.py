@@ -29,7 +29,9 @@ class ReducedTerms:
 
 
 class ReducedLagrangian:
-    """L̃(q, q̇) of a :class:`~.slow_manifold.SlowManifold` and a full model (module doc)."""
+    """L̃(q, q̇) of a :class:`~.slow_manifold.SlowManifold` and a full model (module doc). On an
+    affine manifold (``is_affine``: DX = Pᵀ constant, D²X = 0) M̃ = P M Pᵀ is computed once and
+    ∂M̃ = 0."""
 
     def __init__(self, manifold, mass, potential):
         self.manifold = manifold
@@ -45,6 +47,8 @@ class ReducedLagrangian:
 
     def terms(self, q) -> ReducedTerms:
         q = np.asarray(q, dtype=np.float64).reshape(1, -1)
+        if getattr(self.manifold, "is_affine", False):
+            return self._affine_terms(q)
         X, DX, D2X = self.manifold.evaluate(q, order=2)
         x, J, H = X[0], DX[0], D2X[0]                             # (D,), (D, d), (D, d, d)
         d = J.shape[1]
@@ -55,3 +59,14 @@ class ReducedLagrangian:
         V, gV = self.potential(x)
         return ReducedTerms(mass=0.5 * (Mt + Mt.T), mass_derivative=dM.reshape(d, d, d),
                             potential=float(V), force=-(J.T @ np.asarray(gV, float)))
+
+    def _affine_terms(self, q) -> ReducedTerms:
+        if getattr(self, "_affine_mass", None) is None:
+            J = self.manifold.P.T                                 # (D, d)
+            Mt = J.T @ self._apply_mass(J).reshape(J.shape)
+            self._affine_mass = 0.5 * (Mt + Mt.T)
+        d = q.shape[1]
+        V, gV = self.potential(self.manifold.evaluate(q)[0])
+        return ReducedTerms(mass=self._affine_mass, mass_derivative=np.zeros((d, d, d)),
+                            potential=float(V),
+                            force=-(self.manifold.P @ np.asarray(gV, float)))

@@ -20,7 +20,7 @@ from pointatlas.stores_config import stores_config
 
 from . import lme_kernels as K
 from .lme_kernel_2d import lme_kernel_2d
-from .support import SupportGrid, locality, nodal_spacing, support_radius
+from .support import SupportGrid, locality, nodal_spacing, support_radius, threads_for
 from .validation import (
     LOCALITY_CONSTRAINTS,
     check_nodes,
@@ -217,9 +217,10 @@ class LocalMaxEnt:
         previous = numba.set_parallel_chunksize(4)
         try:
             kernel = lme_kernel_2d if d == 2 else K.lme_kernel
-            kernel(*cells.args(), entry_beta, indptr,
-                   float(self.newton_tol) * self.h_ref_, int(self.max_iter), order,
-                   indices, values, grads, hess, status)
+            with threads_for(len(cells.points)):
+                kernel(*cells.args(), entry_beta, indptr,
+                       float(self.newton_tol) * self.h_ref_, int(self.max_iter), order,
+                       indices, values, grads, hess, status)
         finally:
             numba.set_parallel_chunksize(previous)
         arrays = [indices, values, grads if order >= 1 else None, hess if order >= 2 else None]

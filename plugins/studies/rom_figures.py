@@ -101,9 +101,24 @@ def _strips(ds):
     return fig
 
 
+def _stopped(ds) -> str:
+    """'; stopped early: nlie d=2 (t = 0.13, 0.40 of 1), …' from reduced_time_reached."""
+    R = ds["reduced_time_reached"]
+    window = float(ds["test_window"])
+    out = []
+    for m in ds["method"].values:
+        for d in ds["n_components"].values:
+            r = R.sel({"method": m, "n_components": d}).values
+            if np.all(np.isfinite(r)) and np.any(r < window * (1 - 1e-9)):
+                out.append(f"{m} d={d} (t = {', '.join(f'{v:.2g}' for v in r)} of "
+                           f"{window:g})")
+    return "; reduced runs that left the sampled region or failed Newton (no D): " + \
+        ", ".join(out) if out else ""
+
+
 def figures(ds):
     out = [("Trajectory distance D and reconstruction error e against the dimension d "
-            "(held-out trajectories)", _against_d(ds)),
+            "(held-out trajectories)" + _stopped(ds), _against_d(ds)),
            ("Intrinsic dimension a priori: correlation dimension and local PCA residual "
             "variance of the landmark training set", _dimension(ds))]
     names = [str(m) for m in ds["method"].values if f"embedding_{m}" in ds]

@@ -24,27 +24,26 @@
    pruned to the boundary landmark nodes (clamped nodes excluded).
 
 Measured on this machine (2 cores, numba threads 2, OpenMP layer), ``MPLBACKEND=Agg python
-benchmarks/bench_rom.py`` (6.5 min in all, peak RSS 5.2 GB):
+benchmarks/bench_rom.py`` (about 6 min in all, peak RSS 5.2 GB), 2026-12-05:
 
-    full model, 4 945 nodes, Δt 2e-5    196 µs / step      9.81 s wall per simulated s
-    manifold: 20 000 snapshots, n_bins 49 → 2 035 LME nodes, fit 43 s, residual 5.8e-5
-    table 129 × 129: built in 82 s, table_error 2.35e-3 (M̃; Ṽ 1.9e-5), 77 % cells usable
-    reduced, tabulated, Δt 1e-4        0.102 µs / step    1.02e-3 s per simulated s   9 600×
-    reduced, direct, Δt 1e-4           56 800 µs / step   568 s per simulated s       0.017×
-    NLIE, D = 898 (449 landmarks)      N 5 000: 19.9 s, 10 000: 66.9 s, 20 000: 127 s
-    (--large, run alone: N 50 000: 493 s, not converged, grad_max / tol = 160)
+    full model, 4 945 nodes, Δt 2e-5    197 µs / step      9.87 s wall per simulated s
+    manifold: 20 000 snapshots, n_bins 49 → 2 035 LME nodes, fit 42 s, residual 5.8e-5
+    table 129 × 129: built in 65 s, table_error 2.35e-3 (M̃; Ṽ 1.2e-5), 77 % cells usable
+    reduced, tabulated, Δt 1e-4        0.121 µs / step    1.21e-3 s per simulated s   8 130×
+    reduced, direct, Δt 1e-4           9 020 µs / step    90.2 s per simulated s      0.11×
+    NLIE, D = 898 (449 landmarks)      N 5 000: 15.0 s, 10 000: 48.0 s, 20 000: 98.1 s
+    (--large, run alone earlier: N 50 000: 493 s, not converged, grad_max / tol = 160)
 
-The tabulated reduced model meets the 100× target by two orders of magnitude. The direct one
-is 58× slower than the full model: each step evaluates ``terms`` twice (the step and the saved
-energy), each an LME evaluation of one point through numba ``parallel`` kernels, whose launch
-costs ~8 ms here with the OpenMP layer (≈ 10 ms / step with NUMBA_THREADING_LAYER=workqueue),
-plus a full-mesh energy and force (~0.35 ms). The reduced dynamics (modes at 4.8 and 19 rad/s)
-is sensitive: round-off in the fit changes max |q| between 0.37 and 0.47 from run to run, but
-the energy confines it to |q| ≲ 0.5, inside the disc. The house NLIE reference (swiss roll,
-D = 3, benchmarks/results/bench_nlie.nc): 20 000 points in 21.9 s. Here D = 898 makes the
-Euclidean steps dominate (at N = 50 000: farthest-point sampling of the landmark-Isomap seed
-183 s, check_distinct 93 s, k-NN graph 89 s, Newton 97 s); at N = 10 000 Newton sometimes
-stops unconverged after 50 iterations (round-off dependent), hence the varying times.
+The tabulated reduced model meets the 100× target by almost two orders of magnitude. The
+direct one (an LME evaluation of 2 035 nodes with second derivatives, D²X of the full mesh and
+a full-mesh energy and force, twice per step: the step and the saved energy) is 9× slower than
+the full model; before single points ran on one numba thread (``support.threads_for``) the
+thread team's wake-up made it 57 ms per step. The reduced dynamics (modes at 4.8 and
+19 rad/s) is sensitive: round-off in the fit changes max |q| between 0.37 and 0.47 from run to
+run, but the energy confines it inside the disc. NLIE here is 4.5–7× slower than the house
+NLIE reference (swiss roll, D = 3, benchmarks/results/bench_nlie.nc: 20 000 points in
+21.9 s): with D = 898 the Euclidean steps dominate (at N = 50 000: farthest-point sampling
+of the landmark-Isomap seed 183 s, check_distinct 93 s, k-NN graph 89 s, Newton 97 s).
 
 Usage: python benchmarks/bench_rom.py [--quick] [--large] [--full-steps N] [--rom-steps N]
 ``--quick``: 2 000 triangles, NLIE at N = 2 000 only (a smoke check, well under a minute).

@@ -3,8 +3,8 @@ CMAME 261–262 (2013) 118, §3).
 
 Snapshots x_i ∈ R^D with embedding coordinates q_i ∈ R^d (any embedder). The embedding is
 binned on a grid of square cells, ``n_bins`` along the longest side; the mean q of the
-snapshots in each non-empty cell is a node q_a, and the vertices of the embedding's convex hull are nodes too
-(the bin means alone would leave the outermost snapshots outside the basis' domain).
+snapshots in each non-empty cell is a node q_a, and the vertices of the embedding's convex hull
+are nodes too (the bin means alone would leave the outermost snapshots outside the basis' domain).
 Snapshots the basis still cannot reach (on the hull's boundary, where the LME dual has no
 solution) are left out of the fit and counted (``n_unfitted_``). Local max-ent basis
 functions p_a(q) on the nodes (the ``approximant`` plugin) parametrise the manifold,

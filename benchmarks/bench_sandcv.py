@@ -25,8 +25,8 @@ from pointatlas_embedders.isomap import Isomap
 from pointatlas_molecular.biased_md import run_eabf
 from pointatlas_molecular.dihedral_cv import DihedralCV
 from pointatlas_molecular.eabf import EABF
-from pointatlas_molecular.engine import (PHI, langevin_context, load_system, positions_of,
-                                         unbiased_frames)
+from pointatlas_molecular.engine import (PHI, dihedrals, langevin_context, load_system,
+                                         positions_of, unbiased_frames)
 from pointatlas_molecular.training import train_sandcv
 
 KT = 0.0083144626 * 300
@@ -70,15 +70,17 @@ def main():
         for _ in range(20):
             v = cv(x, start)
         times.append((time.perf_counter() - t) / 20)
-        steps.append(v.steps)
+        if v.ok:
+            steps.append(v.steps)
     print(f"SandCV evaluation (warm-started, Python call included): median "
           f"{1e6 * np.median(times):.1f} µs, 90th percentile {1e6 * np.percentile(times, 90):.1f}"
-          f" µs, Newton steps ≤ {max(steps)} over {len(times)} configurations")
+          f" µs; Newton steps of the accepted ones (count by steps 0, 1, …): "
+          f"{np.bincount(steps).tolist()}, {len(times)} of 200 configurations accepted")
     lo, hi = np.percentile(Q[:, 0], [1, 99])
     for platform in ("Reference", "CPU"):
         n = 20000 if platform == "Reference" else 5000
         for name, c, atoms, e in (
-                ("SandCV ξ₁", cv, heavy, EABF(lo, hi, 40, k=2e4, mass=0.05, kT=KT,
+                ("SandCV ξ₁", cv, heavy, EABF(lo, hi, 40, k=5000.0, mass=5.0, kT=KT,
                                               lam=float(Q[-1, 0]))),
                 ("φ", DihedralCV(PHI), np.array(PHI),
                  EABF(-np.pi, np.pi, 72, k=1000.0, mass=0.5, kT=KT, period=2 * np.pi))):
@@ -87,6 +89,22 @@ def main():
             print(f"eABF on {name}, {platform}: {r:.0f} steps/s ({r * NS_DAY:.1f} ns/day), "
                   f"{100 * r / plain[platform]:.0f} % of plain MD; refused steps "
                   f"{run.n_refused}")
+    # exploration: 200 ps of eABF on ξ₁ (Reference): does it reach φ > 0 (C7ax / αL), which
+    # the training run did not sample?
+    train_phi = dihedrals(frames)[:, 0]
+    e = EABF(lo, hi, 40, k=5000.0, mass=5.0, kT=KT, lam=float(Q[-1, 0]))
+    n = 100_000
+    run = run_eabf(mol, cv, heavy, e, n, 4, positions=frames[-1], save_atoms=np.arange(22))
+    phi = dihedrals(run.frames)[:, 0]
+    basin = (phi > 0) & (phi < 120)
+    first = np.flatnonzero(basin)
+    trained = np.mean((train_phi > 0) & (train_phi < 120))
+    print(f"training run: fraction with 0 < φ < 120°: {trained:.4f}; "
+          f"eABF on ξ₁ for {n * 0.002:.0f} ps: fraction {basin.mean():.4f}, first visit "
+          f"{first[0] * 10 * 0.002 if len(first) else float('nan'):.1f} ps, refused steps "
+          f"{run.n_refused} (first at step {run.first_refused_step}), ξ₁ visited "
+          f"[{np.nanmin(run.xi):.3f}, {np.nanmax(run.xi):.3f}] of the training range "
+          f"[{Q[:, 0].min():.3f}, {Q[:, 0].max():.3f}]")
 
 
 if __name__ == "__main__":

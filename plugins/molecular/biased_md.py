@@ -47,9 +47,13 @@ def coupling_force(cv_atoms, n_particles):
 def run_eabf(mol, cv, cv_atoms, eabf: EABF, n_steps: int, seed: int, *, platform="Reference",
              dt=0.002, save_every=10, save_atoms=None, positions=None, progress=None):
     """``n_steps`` of eABF-biased Langevin MD on ``cv`` (SandCV or DihedralCV) of the atoms
-    ``cv_atoms``; returns a :class:`BiasedRun`."""
+    ``cv_atoms``; returns a :class:`BiasedRun`. λ starts at ξ of the start configuration,
+    which must have a trustworthy CV inside the eABF range."""
     import copy
 
+    from pointatlas.errors import PointatlasError
+
+    eabf.check_time_step(dt)
     system = copy.deepcopy(mol.system)
     force = coupling_force(cv_atoms, system.getNumParticles())
     system.addForce(force)
@@ -60,12 +64,29 @@ def run_eabf(mol, cv, cv_atoms, eabf: EABF, n_steps: int, seed: int, *, platform
     n_save = n_steps // save_every
     xi_out, lam_out = np.empty(n_save), np.empty(n_save)
     frames = np.empty((n_save, len(save_atoms), 3), dtype=np.float32)
+    x0 = positions_of(ctx)[cv_atoms]
+    v0 = cv(x0)
+    if not v0.ok:
+        raise PointatlasError(f"the starting configuration has no trustworthy CV value "
+                              f"({v0.reason}); start from a configuration the CV was trained "
+                              f"near.")
+    xi0 = float(v0.xi[0])
+    inside = eabf.bin(xi0) >= 0
+    if not inside:
+        raise PointatlasError(f"the CV range [{eabf.lower:g}, {eabf.upper:g}] excludes the "
+                              f"starting configuration (ξ = {xi0:.4g}); widen the range or "
+                              f"start inside it.")
+    eabf.lam, eabf.vel = xi0, 0.0     # λ starts on ξ: no initial kick
     prev = None
     refused, first_refused, newton_max = 0, -1, 0
     x_prev = None
     t0 = time.perf_counter()
     for s in range(n_steps):
         pos = positions_of(ctx)
+        if not np.all(np.isfinite(pos)):
+            raise PointatlasError(
+                f"biased MD blew up at step {s} (non-finite positions): lower the coupling "
+                f"k or the time step, or raise the extended variable's mass.")
         x = pos[cv_atoms]
         start_xi = None
         if prev is not None and prev.ok:

@@ -53,6 +53,15 @@ class EABF:
     z_lam_sum: np.ndarray = field(init=False)
 
     def __post_init__(self):
+        from pointatlas.errors import ConfigError
+
+        if not self.lower < self.upper:
+            raise ConfigError(f"eABF range [{self.lower:g}, {self.upper:g}] is empty; give "
+                              f"lower < upper.")
+        if not self.lower <= self.lam <= self.upper:
+            raise ConfigError(f"the starting configuration's CV value {self.lam:g} lies outside "
+                              f"the eABF range [{self.lower:g}, {self.upper:g}]; widen the "
+                              f"range or start elsewhere.")
         self.f_sum = np.zeros(self.n_bins)
         self.f_count = np.zeros(self.n_bins, dtype=np.int64)
         self.z_count = np.zeros(self.n_bins, dtype=np.int64)
@@ -72,6 +81,21 @@ class EABF:
     def coupling(self, xi: float) -> float:
         """k (ξ − λ): the force on λ and, times −∂ξ/∂x, the force on the atoms."""
         return self.k * wrap(xi - self.lam, self.period)
+
+    def period_of_lambda(self) -> float:
+        """Oscillation period 2π √(m/k) of λ in the coupling well (ps)."""
+        return 2 * np.pi * np.sqrt(self.mass / self.k)
+
+    def check_time_step(self, dt: float) -> None:
+        """λ's oscillation must span ≥ 10 time steps, or its integration is unstable."""
+        from pointatlas.errors import ConfigError
+
+        if self.period_of_lambda() < 10 * dt:
+            raise ConfigError(
+                f"the extended variable oscillates with period {self.period_of_lambda():.3g} "
+                f"ps, under 10 time steps of {dt:g} ps: its integration would blow up. Raise "
+                f"its mass to at least {self.k * (10 * dt / (2 * np.pi)) ** 2:.3g} or lower "
+                f"the coupling.")
 
     def step(self, xi: float, rng: np.random.Generator, dt: float) -> None:
         """Accumulate at (ξ, λ), then advance λ by one BAOAB step of Langevin dynamics."""

@@ -18,8 +18,8 @@ where H is not positive definite the point is not a local minimum of the distanc
 
 Status codes: OK; OUTSIDE (ξ where no basis exists: the start point, or no step stays in the
 parametrised region); NOT_CONVERGED (``max_iter`` Newton steps); NOT_A_MINIMUM (H not
-positive definite at the solution); NEAR_FOCAL (the conditioning c outside [min_conditioning, 1/min_conditioning]:
-near the focal set, or a fit that curves sharply away within the distance);
+positive definite at the solution); NEAR_FOCAL (the conditioning c outside
+[min_conditioning, 1/min_conditioning]: near the focal set, or a fit that curves sharply away within the distance);
 FOLDED (σ_min/σ_max of DX below ``FOLD_RATIO``: the fitted X(ξ) nearly folds there, so ξ
 is not a coordinate of the manifold).
 

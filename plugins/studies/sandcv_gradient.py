@@ -1,6 +1,7 @@
 """SandCV's own checks on alanine dipeptide (issue 22's ``sandcv_gradient``).
 
-Training: an unbiased Langevin run (300 K, 2 fs, H-bonds constrained; ``n_frames`` frames
+Training: ``trajectory`` (a DCD/XTC/HDF5/… file of the system, read by mdtraj, every frame
+used) or else an unbiased Langevin run (300 K, 2 fs, H-bonds constrained; ``n_frames`` frames
 every ``stride`` steps after ``equilibration``), its heavy atoms (D = 30) superposed by mdtraj,
 embedded by the ``embedder`` (Isomap, d = 2), parametrised by the ``approximant`` (LME) on
 ``n_bins`` binned nodes (:mod:`pointatlas_molecular.sandcv`). Tests: ``n_test``
@@ -23,7 +24,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import ClassVar, Optional
 
 import numpy as np
 
@@ -35,6 +36,7 @@ from pointatlas.stores_config import stores_config
 class SandCVGradientSettings:
     system: str = "alanine_dipeptide_vacuum"
     platform: str = "Reference"
+    trajectory: Optional[str] = None
     n_frames: int = 2000
     stride: int = 50
     equilibration: int = 5000
@@ -93,10 +95,16 @@ class SandCVGradient:
         seeds = ctx.rng("md").integers(1, 2**31 - 1, 2)
         with ctx.timed("training_md"):
             t0 = time.perf_counter()
-            frames = unbiased_frames(mol, self.n_frames, self.stride, int(seeds[0]),
-                                     self.equilibration, self.platform)
+            if self.trajectory:
+                from pointatlas_molecular.ensemble import read_trajectory
+
+                frames = read_trajectory(self.trajectory, mol.topology, len(mol.positions))
+                n_steps = 0
+            else:
+                frames = unbiased_frames(mol, self.n_frames, self.stride, int(seeds[0]),
+                                         self.equilibration, self.platform)
+                n_steps = self.equilibration + self.n_frames * self.stride
             md_wall = time.perf_counter() - t0
-        n_steps = self.equilibration + self.n_frames * self.stride
         with ctx.timed("training"):
             cv, Z, Q = train_sandcv(frames, heavy, ctx.plugin("embedder"),
                                     ctx.plugin("approximant"), self.n_bins, self.newton_tol,
@@ -153,7 +161,7 @@ class SandCVGradient:
                ("psi", phipsi[:, 1], "backbone dihedral ψ", "degree"))
         for name, val, long, units in per:
             _v(ds, name, val, long, units, ("configuration",))
-        ns_day = n_steps * 0.002e-3 / md_wall * 86400
+        ns_day = n_steps * 0.002e-3 / md_wall * 86400 if n_steps else np.nan
         for name, val, long, units in (
                 ("gradient_error", np.nanmax(grad_err) if ok.any() else np.nan,
                  "worst max |∂ξ/∂x − FD| / max |FD| over the accepted configurations", "1"),

@@ -26,3 +26,19 @@ def test_too_few_frames_for_the_embedding_are_refused(run_cli, tmp_path):
                   f"outputs_root={tmp_path}", cwd=tmp_path)
     assert out.returncode != 0 and "Traceback" not in out.stderr
     assert "too few" in out.stderr
+
+
+def test_a_trajectory_of_another_system_is_refused(run_cli, tmp_path):
+    import mdtraj
+    import numpy as np
+
+    top = mdtraj.Topology()
+    res = top.add_residue("X", top.add_chain())
+    for _ in range(5):
+        top.add_atom("C", mdtraj.element.carbon, res)
+    path = tmp_path / "other.dcd"
+    mdtraj.Trajectory(np.zeros((3, 5, 3), np.float32), top).save_dcd(str(path))
+    out = run_cli("pointatlas", "experiment=sandcv_gradient", f"study.trajectory={path}",
+                  f"outputs_root={tmp_path}", cwd=tmp_path)
+    assert out.returncode != 0 and "Traceback" not in out.stderr
+    assert "topology does not match" in out.stderr or "cannot read trajectory" in out.stderr

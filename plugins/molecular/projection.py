@@ -41,6 +41,9 @@ STATUS_NAMES = ("ok", "outside the parametrised region", "not converged",
                 "not a minimum of the distance",
                 "ill-conditioned (near the focal set, or the fit curves sharply there)",
                 "where the parametrisation folds")
+#: step halvings before a projection that keeps leaving the parametrised region gives up
+#: (a refused configuration must stay cheap: each halving is a basis evaluation)
+MAX_HALVINGS = 10
 #: σ_min/σ_max of DX below this: X(ξ) is (nearly) rank-deficient, the chart folds
 FOLD_RATIO = 1e-2
 
@@ -170,7 +173,7 @@ def project(z, xi, nodes, beta, r2, P, lme_tol, lme_max_iter, tol, max_iter, min
         small = np.sqrt(np.sum(step * step)) < tol
         t = 1.0
         accepted = False
-        for _ in range(30):
+        for _ in range(MAX_HALVINGS):
             for i in range(d):
                 trial[i] = xi[i] + t * step[i]
             phit = _state(z, trial, nodes, beta, r2, P, lme_tol, lme_max_iter, w, Xt, DXt,

@@ -119,8 +119,35 @@ def scratch(n_nodes, d):
 
 
 @nb.njit(cache=True)
-def _state(z, xi, nodes, beta, r2, P, lme_tol, lme_max_iter, w, X, DX, D2X, F, H):
-    """X, DX, D²X at ξ, F = DXᵀ(X − z), H = DXᵀDX + Σ (X − z) D²X; returns φ (inf outside)."""
+def inside_hull(q, hull):
+    """Whether q satisfies every facet inequality n·q + c ≤ 0 of the nodes' convex hull
+    (rows [n, c]; a tiny slack for round-off)."""
+    d = q.shape[0]
+    for f in range(hull.shape[0]):
+        s = hull[f, d]
+        for j in range(d):
+            s += hull[f, j] * q[j]
+        if s > 1e-12:
+            return False
+    return True
+
+
+def hull_equations(nodes) -> np.ndarray:
+    """Facet inequalities [n, c] (n·q + c ≤ 0 inside) of the convex hull of the nodes."""
+    nodes = np.asarray(nodes, dtype=np.float64)
+    if nodes.shape[1] == 1:
+        return np.array([[1.0, -nodes.max()], [-1.0, nodes.min()]])
+    from scipy.spatial import ConvexHull
+
+    return np.ascontiguousarray(ConvexHull(nodes).equations)
+
+
+@nb.njit(cache=True)
+def _state(z, xi, nodes, beta, r2, P, hull, lme_tol, lme_max_iter, w, X, DX, D2X, F, H):
+    """X, DX, D²X at ξ, F = DXᵀ(X − z), H = DXᵀDX + Σ (X − z) D²X; returns φ (inf outside:
+    outside the nodes' hull is decided by its facets, before any costly dual solve)."""
+    if not inside_hull(xi, hull):
+        return np.inf
     k, ok = _basis(xi, nodes, beta, r2, lme_tol, lme_max_iter, 2, w)
     if not ok:
         return np.inf
@@ -144,8 +171,8 @@ def _state(z, xi, nodes, beta, r2, P, lme_tol, lme_max_iter, w, X, DX, D2X, F, H
 
 
 @nb.njit(cache=True)
-def project(z, xi, nodes, beta, r2, P, lme_tol, lme_max_iter, tol, max_iter, min_cond, w,
-            J):
+def project(z, xi, nodes, beta, r2, P, hull, lme_tol, lme_max_iter, tol, max_iter, min_cond,
+            w, J):
     """Project z (D,) from the start ``xi`` (d,, overwritten with ξ(z)); ∂ξ/∂z into J (d, D).
 
     Returns (status, Newton steps taken, distance |X(ξ) − z|, conditioning c). ``tol``:
@@ -160,7 +187,7 @@ def project(z, xi, nodes, beta, r2, P, lme_tol, lme_max_iter, tol, max_iter, min
     H, Ht = np.empty((d, d)), np.empty((d, d))
     F, Ft = np.empty(d), np.empty(d)
     trial = np.empty(d)
-    phi = _state(z, xi, nodes, beta, r2, P, lme_tol, lme_max_iter, w, X, DX, D2X, F, H)
+    phi = _state(z, xi, nodes, beta, r2, P, hull, lme_tol, lme_max_iter, w, X, DX, D2X, F, H)
     if not np.isfinite(phi):
         return OUTSIDE, 0, np.inf, 0.0
     it = 0
@@ -176,14 +203,19 @@ def project(z, xi, nodes, beta, r2, P, lme_tol, lme_max_iter, tol, max_iter, min
         for _ in range(MAX_HALVINGS):
             for i in range(d):
                 trial[i] = xi[i] + t * step[i]
-            phit = _state(z, trial, nodes, beta, r2, P, lme_tol, lme_max_iter, w, Xt, DXt,
-                          D2Xt, Ft, Ht)
+            phit = _state(z, trial, nodes, beta, r2, P, hull, lme_tol, lme_max_iter, w, Xt,
+                          DXt, D2Xt, Ft, Ht)
             if phit <= phi * (1.0 + 1e-14) + 1e-300:
                 accepted = True
                 break
             t *= 0.5
         if not accepted:
-            if small:           # at the round-off floor: ξ is converged
+            # at the round-off floor (the step is below tol, or the quadratic model promises
+            # a decrease of φ below its round-off): ξ is converged
+            predicted = 0.0
+            for i in range(d):
+                predicted -= 0.5 * F[i] * step[i]
+            if small or predicted <= 1e-12 * phi:
                 converged = True
                 break
             return OUTSIDE, it, np.sqrt(2 * phi), 0.0

@@ -20,12 +20,12 @@ import numpy as np
 from pointatlas.errors import InputError
 
 from .kabsch import pull_back, superpose
-from .projection import OK, STATUS_NAMES, project, scratch
+from .projection import OK, STATUS_NAMES, hull_equations, project, scratch
 
 
 @nb.njit(cache=True)
-def _evaluate(x, ref, wts, nodes, beta, r2, P, lme_tol, lme_max_iter, tol, max_iter, min_cond,
-              xi, grad):
+def _evaluate(x, ref, wts, nodes, beta, r2, P, hull, lme_tol, lme_max_iter, tol, max_iter,
+              min_cond, xi, grad):
     """ξ (overwriting the start ``xi``) and ∂ξ/∂x into grad (d, n, 3):
     (status, steps, distance, conditioning)."""
     n = x.shape[0]
@@ -35,7 +35,7 @@ def _evaluate(x, ref, wts, nodes, beta, r2, P, lme_tol, lme_max_iter, tol, max_i
     superpose(x, ref, wts, z, R)
     J = np.empty((d, 3 * n))
     w = scratch(nodes.shape[0], d)
-    status, steps, dist, cond = project(z.ravel(), xi, nodes, beta, r2, P, lme_tol,
+    status, steps, dist, cond = project(z.ravel(), xi, nodes, beta, r2, P, hull, lme_tol,
                                         lme_max_iter, tol, max_iter, min_cond, w, J)
     if status == OK:
         g = np.empty((n, 3))
@@ -105,6 +105,7 @@ class SandCV:
         self.beta_ = np.ascontiguousarray(basis.beta_)
         self.r2_ = np.ascontiguousarray(basis.radius_ ** 2)
         self.P_ = np.ascontiguousarray(self.manifold_.P_)
+        self.hull_ = hull_equations(self.nodes_)
         self.lme_tol_ = float(basis.newton_tol) * basis.h_ref_
         self.lme_max_iter_ = int(basis.max_iter)
         self.step_tol_ = self.tol * float(np.max(np.ptp(self.nodes_, axis=0)))
@@ -147,7 +148,7 @@ class SandCV:
         grad = np.zeros((self.dim, self.n_atoms, 3))
         status, steps, dist, cond = _evaluate(
             x, self.reference_, self.weights_, self.nodes_, self.beta_, self.r2_, self.P_,
-            self.lme_tol_, self.lme_max_iter_,
+            self.hull_, self.lme_tol_, self.lme_max_iter_,
             self.step_tol_ if tol is None else tol * self.step_tol_ / self.tol, self.max_iter,
             self.min_conditioning, xi, grad)
         return CVValue(xi, grad, float(dist), int(steps), int(status), float(cond))

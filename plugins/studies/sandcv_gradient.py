@@ -9,7 +9,7 @@ configurations of an independent run (another seed), off the training set. For e
 
 - ``gradient_error``: max_ij |∂ξ/∂x − FD|_ij / max_ij |FD|_ij, FD the fourth-order central
   difference (h = ``fd_step`` nm) of ξ (every evaluation warm-started from ξ(x) and converged
-  to 1e-14 relative, so that the reference is not limited by the MD tolerance);
+  to 1e-12 relative, so that the reference is not limited by the MD tolerance);
 - ``rigid_motion_error``: max |ξ(Q x + t) − ξ(x)| over a random rotation Q and translation t,
   relative to the extent of the embedding (both from the same start);
 - ``newton_steps``: Newton steps of the projection warm-started as during biased MD: from
@@ -64,7 +64,7 @@ def fd_gradient(cv, x, xi, h):
             for s in (-2, -1, 1, 2):
                 e = x.copy()
                 e[i, a] += s * h
-                vals.append(cv(e, xi, tol=1e-14).xi)
+                vals.append(cv(e, xi, tol=1e-12).xi)
             out[:, i, a] = (vals[0] - 8 * vals[1] + 8 * vals[2] - vals[3]) / (12 * h)
     return out
 

@@ -11,8 +11,17 @@ Measures, on this machine:
 
 Run: ``MPLBACKEND=Agg python benchmarks/bench_sandcv.py`` (about 3 minutes).
 
-Measured here (2-core machine, 2026-12-05):
-  see the closing note of issue 22 (the script prints every figure).
+Measured here (2-core machine, 2026-12-05, four runs; the CPU platform's rates vary 2–4×
+from run to run on these shared cores):
+  plain MD: Reference 43 000–57 000 steps/s (7 500–9 800 ns/day), CPU 1 960–7 500 steps/s
+  SandCV evaluation: median 76–111 µs (90th percentile 101–124 µs); Newton steps of 200
+    configurations: 2 (20), 3 (174), 4 (5), 19 (1)
+  eABF on SandCV ξ₁: Reference 1 840–2 730 steps/s (320–470 ns/day, 3–5 % of plain MD);
+    CPU 97–624 steps/s (2–18 %)
+  eABF on φ: Reference 2 900–4 400 steps/s (5–10 %); CPU 610–2 100 steps/s (11–57 %)
+  exploration, 200 ps of eABF on ξ₁: no sample with 0 < φ < 120° (nor in training)
+The ≥ 50 % of plain MD target is missed: per step, positions out (20–50 µs), CV (~100 µs),
+λ and 10 × 3 force parameters in (~35 µs) cost more than a Reference step (~18 µs).
 """
 from __future__ import annotations
 

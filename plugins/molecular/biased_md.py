@@ -31,7 +31,7 @@ class BiasedRun:
     newton_steps_max: int
 
 
-def coupling_force(cv_atoms, n_particles):
+def coupling_force(cv_atoms):
     """A CustomExternalForce on ``cv_atoms`` with zeroed per-particle (fx, fy, fz)."""
     import openmm as mm
 
@@ -55,7 +55,7 @@ def run_eabf(mol, cv, cv_atoms, eabf: EABF, n_steps: int, seed: int, *, platform
 
     eabf.check_time_step(dt)
     system = copy.deepcopy(mol.system)
-    force = coupling_force(cv_atoms, system.getNumParticles())
+    force = coupling_force(cv_atoms)
     system.addForce(force)
     start = mol.positions if positions is None else positions
     ctx, integ = langevin_context(system, start, seed, platform, dt=dt)
@@ -77,6 +77,7 @@ def run_eabf(mol, cv, cv_atoms, eabf: EABF, n_steps: int, seed: int, *, platform
                               f"starting configuration (ξ = {xi0:.4g}); widen the range or "
                               f"start inside it.")
     eabf.lam, eabf.vel = xi0, 0.0     # λ starts on ξ: no initial kick
+    predicts = hasattr(cv, "predict")
     prev = None
     refused, first_refused, newton_max = 0, -1, 0
     x_prev = None
@@ -90,7 +91,7 @@ def run_eabf(mol, cv, cv_atoms, eabf: EABF, n_steps: int, seed: int, *, platform
         x = pos[cv_atoms]
         start_xi = None
         if prev is not None and prev.ok:
-            start_xi = cv.predict(prev, x_prev, x) if hasattr(cv, "predict") else prev.xi
+            start_xi = cv.predict(prev, x_prev, x) if predicts else prev.xi
         v = cv(x, start_xi)
         if v.ok:
             newton_max = max(newton_max, v.steps)

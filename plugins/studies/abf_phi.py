@@ -20,6 +20,7 @@ import numpy as np
 
 from pointatlas.constraints import Interval
 from pointatlas.stores_config import stores_config
+from pointatlas_studies.reduced_pendulum import _v
 
 KB = 0.0083144626  # kJ/mol/K
 
@@ -79,10 +80,6 @@ def aligned_rms(a, b):
     ok = np.isfinite(a) & np.isfinite(b)
     d = a[ok] - b[ok]
     return float(np.sqrt(np.mean((d - d.mean()) ** 2))), int(ok.sum())
-
-
-def _v(ds, name, value, long_name, units="1", dims=()):
-    ds[name] = (dims, value, {"long_name": long_name, "units": units})
 
 
 @stores_config

@@ -30,6 +30,7 @@ import numpy as np
 
 from pointatlas.constraints import Interval
 from pointatlas.stores_config import stores_config
+from pointatlas_studies.reduced_pendulum import _v
 
 
 @dataclass
@@ -67,10 +68,6 @@ def fd_gradient(cv, x, xi, h):
                 vals.append(cv(e, xi, tol=1e-12).xi)
             out[:, i, a] = (vals[0] - 8 * vals[1] + 8 * vals[2] - vals[3]) / (12 * h)
     return out
-
-
-def _v(ds, name, value, long_name, units="1", dims=()):
-    ds[name] = (dims, value, {"long_name": long_name, "units": units})
 
 
 @stores_config

@@ -110,19 +110,23 @@ class EABF:
             self.z_lam_sum[bz] += wrap(self.lam - xi, self.period)
         total = f + self.bias(bl)
         self.vel += 0.5 * dt * total / self.mass
-        self.lam += 0.5 * dt * self.vel
+        self._drift(0.5 * dt)
         c = np.exp(-self.friction * dt)
         self.vel = c * self.vel + np.sqrt((1 - c * c) * self.kT / self.mass) * rng.normal()
-        self.lam += 0.5 * dt * self.vel
-        if self.period is not None:
-            self.lam = self.lower + (self.lam - self.lower) % self.period
-        elif self.lam < self.lower or self.lam > self.upper:          # reflecting walls
-            self.lam = 2 * self.lower - self.lam if self.lam < self.lower else \
-                2 * self.upper - self.lam
-            self.vel = -self.vel
+        self._drift(0.5 * dt)
         # the second half kick uses the force at the new λ (the same ξ: x moves next)
         f2 = self.k * wrap(xi - self.lam, self.period)
         self.vel += 0.5 * dt * (f2 + self.bias(self.bin(self.lam))) / self.mass
+
+    def _drift(self, h: float) -> None:
+        """λ += h v, folded (periodic) or reflected at the walls (mirror, reverse v)."""
+        self.lam += h * self.vel
+        if self.period is not None:
+            self.lam = self.lower + (self.lam - self.lower) % self.period
+        elif self.lam < self.lower or self.lam > self.upper:
+            self.lam = 2 * self.lower - self.lam if self.lam < self.lower else \
+                2 * self.upper - self.lam
+            self.vel = -self.vel
 
     def bias(self, b: int) -> float:
         """Minus the ramped running mean of F_λ in bin b (0 outside the range)."""

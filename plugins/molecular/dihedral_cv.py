@@ -10,6 +10,7 @@ G = r_j − r_k, H = r_l − r_k, A = F × G, B = H × G,
 
 Same call interface as :class:`.sandcv.SandCV` (``cv(x, start)`` → a value with ``xi``,
 ``gradient``, ``ok``), so the biased-MD driver takes either; periodic with period 2π.
+:class:`DihedralPairCV` is two of them, e.g. (φ, ψ).
 """
 from __future__ import annotations
 
@@ -43,3 +44,34 @@ class DihedralCV:
         grad[0, 1] = g / a2 * A + fg / (a2 * g) * A - hg / (b2 * g) * B
         grad[0, 2] = -g / b2 * B - fg / (a2 * g) * A + hg / (b2 * g) * B
         return CVValue(np.array([phi]), grad, 0.0, 0, 0, 1.0)
+
+
+class DihedralPairCV:
+    """(φ, ψ) of two dihedrals sharing atoms, e.g. the backbone of alanine dipeptide:
+    ``atoms`` the union of their atoms (the CV atoms, in this order), ``first`` and
+    ``second`` the four positions of each dihedral within ``atoms``."""
+
+    dim = 2
+    period = 2.0 * np.pi
+
+    def __init__(self, atoms, first, second):
+        self.atoms = np.asarray(atoms, dtype=int)
+        self.parts = (np.asarray(first, dtype=int), np.asarray(second, dtype=int))
+        self._one = DihedralCV(np.arange(4))
+
+    @classmethod
+    def of(cls, quad1, quad2):
+        """The pair of dihedrals given by system atom indices (quad1, quad2)."""
+        atoms = np.array(sorted(set(quad1) | set(quad2)))
+        pos = {a: i for i, a in enumerate(atoms)}
+        return cls(atoms, [pos[a] for a in quad1], [pos[a] for a in quad2])
+
+    def __call__(self, x, xi_start=None) -> CVValue:
+        x = np.asarray(x, dtype=np.float64)
+        xi = np.empty(2)
+        grad = np.zeros((2, len(self.atoms), 3))
+        for k, part in enumerate(self.parts):
+            v = self._one(x[part])
+            xi[k] = v.xi[0]
+            grad[k, part] = v.gradient[0]
+        return CVValue(xi, grad, 0.0, 0, 0, 1.0)

@@ -27,3 +27,21 @@ def test_value_and_gradient(seed):
 def test_a_trans_chain_is_180_degrees():
     x = np.array([[0.0, 1, 0], [0, 0, 0], [1, 0, 0], [1, -1, 0]])
     assert np.isclose(abs(DihedralCV([0, 1, 2, 3])(x).xi[0]), np.pi)
+
+
+def test_pair_of_dihedrals_sharing_atoms():
+    """(φ, ψ) over the union of their atoms: values and gradients are the single dihedrals'
+    scattered into the union, zero on atoms a dihedral does not involve."""
+    from pointatlas_molecular.dihedral_cv import DihedralPairCV
+
+    full = np.random.default_rng(3).normal(size=(20, 3))
+    q1, q2 = (4, 6, 8, 14), (6, 8, 14, 16)
+    pair = DihedralPairCV.of(q1, q2)
+    assert list(pair.atoms) == [4, 6, 8, 14, 16]
+    v = pair(full[pair.atoms])
+    ref = dihedrals(full[None], [q1, q2])[0]
+    assert np.allclose(np.degrees(v.xi), ref)
+    g1 = DihedralCV(np.arange(4))(full[list(q1)]).gradient[0]
+    assert np.allclose(v.gradient[0, :4], g1) and np.all(v.gradient[0, 4] == 0)
+    g2 = DihedralCV(np.arange(4))(full[list(q2)]).gradient[0]
+    assert np.allclose(v.gradient[1, 1:], g2) and np.all(v.gradient[1, 0] == 0)

@@ -21,7 +21,8 @@ from .eabf import EABF
 
 @dataclass
 class BiasedRun:
-    """Per saved step: ξ, λ, the positions of ``save_atoms`` (nm); counts and speed."""
+    """Per saved step: ξ, λ (scalars for a 1-D :class:`.eabf.EABF`, else (d,)), the positions
+    of ``save_atoms`` (nm); counts and speed."""
     xi: np.ndarray
     lam: np.ndarray
     frames: np.ndarray
@@ -44,11 +45,13 @@ def coupling_force(cv_atoms):
     return f
 
 
-def run_eabf(mol, cv, cv_atoms, eabf: EABF, n_steps: int, seed: int, *, platform="Reference",
+def run_eabf(mol, cv, cv_atoms, eabf, n_steps: int, seed: int, *, platform="Reference",
              dt=0.002, save_every=10, save_atoms=None, positions=None, progress=None):
-    """``n_steps`` of eABF-biased Langevin MD on ``cv`` (SandCV or DihedralCV) of the atoms
-    ``cv_atoms``; returns a :class:`BiasedRun`. λ starts at ξ of the start configuration,
-    which must have a trustworthy CV inside the eABF range."""
+    """``n_steps`` of eABF-biased Langevin MD on ``cv`` (SandCV, DihedralCV, DihedralPairCV) of
+    the atoms ``cv_atoms`` with ``eabf`` an :class:`.eabf.EABF` (ξ_0 only) or an
+    :class:`.eabf_grid.EABFGrid` (its ``dim`` first components of ξ); returns a
+    :class:`BiasedRun`. λ starts at ξ of the start configuration, which must have a
+    trustworthy CV inside the eABF range."""
     import copy
 
     from pointatlas.errors import PointatlasError
@@ -62,7 +65,11 @@ def run_eabf(mol, cv, cv_atoms, eabf: EABF, n_steps: int, seed: int, *, platform
     rng = np.random.default_rng(seed)
     save_atoms = np.arange(system.getNumParticles()) if save_atoms is None else save_atoms
     n_save = n_steps // save_every
-    xi_out, lam_out = np.empty(n_save), np.empty(n_save)
+    scalar = isinstance(eabf, EABF)
+    d = 1 if scalar else eabf.dim
+    comp = (lambda xi: float(xi[0])) if scalar else (lambda xi: xi[:d])  # noqa: E731
+    shape = (n_save,) if scalar else (n_save, d)
+    xi_out, lam_out = np.empty(shape), np.empty(shape)
     frames = np.empty((n_save, len(save_atoms), 3), dtype=np.float32)
     x0 = positions_of(ctx)[cv_atoms]
     v0 = cv(x0)
@@ -70,13 +77,13 @@ def run_eabf(mol, cv, cv_atoms, eabf: EABF, n_steps: int, seed: int, *, platform
         raise PointatlasError(f"the starting configuration has no trustworthy CV value "
                               f"({v0.reason}); start from a configuration the CV was trained "
                               f"near.")
-    xi0 = float(v0.xi[0])
-    inside = eabf.bin(xi0) >= 0
+    xi0 = comp(v0.xi)
+    inside = eabf.bin(xi0) >= 0 and (scalar or eabf.inside(xi0))
     if not inside:
-        raise PointatlasError(f"the CV range [{eabf.lower:g}, {eabf.upper:g}] excludes the "
-                              f"starting configuration (ξ = {xi0:.4g}); widen the range or "
-                              f"start inside it.")
-    eabf.lam, eabf.vel = xi0, 0.0     # λ starts on ξ: no initial kick
+        raise PointatlasError(f"the CV range [{eabf.lower}, {eabf.upper}] excludes the "
+                              f"starting configuration (ξ = {np.round(xi0, 4)}); widen the "
+                              f"range or start inside it.")
+    eabf.lam, eabf.vel = (xi0, 0.0) if scalar else (xi0.copy(), np.zeros(d))  # no kick
     predicts = hasattr(cv, "predict")
     prev = None
     refused, first_refused, newton_max = 0, -1, 0
@@ -95,11 +102,12 @@ def run_eabf(mol, cv, cv_atoms, eabf: EABF, n_steps: int, seed: int, *, platform
         v = cv(x, start_xi)
         if v.ok:
             newton_max = max(newton_max, v.steps)
-            c = eabf.coupling(float(v.xi[0]))
-            fvec = -c * v.gradient[0]
+            xi = comp(v.xi)
+            c = eabf.coupling(xi)
+            fvec = -c * v.gradient[0] if scalar else -np.tensordot(c, v.gradient[:d], 1)
             for i in range(len(cv_atoms)):
                 force.setParticleParameters(i, int(cv_atoms[i]), fvec[i].tolist())
-            eabf.step(float(v.xi[0]), rng, dt)
+            eabf.step(xi, rng, dt)
         else:
             refused += 1
             first_refused = s if first_refused < 0 else first_refused
@@ -108,7 +116,7 @@ def run_eabf(mol, cv, cv_atoms, eabf: EABF, n_steps: int, seed: int, *, platform
         force.updateParametersInContext(ctx)
         if s % save_every == 0 and s // save_every < n_save:
             j = s // save_every
-            xi_out[j] = v.xi[0] if v.ok else np.nan
+            xi_out[j] = comp(v.xi) if v.ok else np.nan
             lam_out[j] = eabf.lam
             frames[j] = pos[save_atoms]
         prev, x_prev = v, x

@@ -12,9 +12,10 @@ import re
 import sys
 from pathlib import Path
 
-from .config import CONF_DIR, plugin_config_class, register_configs, valid_keys
+from .config import CONF_DIR, USER_CONFIG_DIRS, plugin_config_class, register_configs, valid_keys
 from .errors import ConfigError, PluginError, PointatlasError
 from .registry import FAMILIES, load_plugin
+from .user_configs import searchpath_override, user_config_dirs
 
 log = logging.getLogger("pointatlas")
 VERSION_BASE = "1.3"
@@ -57,7 +58,7 @@ def explain(exc: Exception, overrides: list[str]) -> str:
 
         if key == "experiment" and value not in experiments():
             return (f"No experiment named {value!r}. Available: {', '.join(sorted(experiments()))}. "
-                    "Fix the name (experiments/ holds the definitions).")
+                    "Fix the name, or add your own as DIR/experiment/<name>.yaml with --config-dir DIR.")
     missing = re.search(r"Could not find '(\w+)/([\w.-]+)'", text)
     if missing and missing.group(1) in FAMILIES.values():
         load_plugin(missing.group(1), missing.group(2))  # raises PluginError naming the cause
@@ -94,8 +95,8 @@ def _valid_keys_for(family: str, overrides: list[str]) -> list[str]:
         from hydra import compose, initialize_config_dir
 
         with initialize_config_dir(config_dir=str(CONF_DIR), version_base=VERSION_BASE):
-            cfg = compose("config", overrides=[o for o in overrides if "." not in o.split("=")[0]],
-                          return_hydra_config=True)
+            cfg = compose("config", overrides=[o for o in overrides if "." not in o.split("=")[0]]
+                          + searchpath_override(USER_CONFIG_DIRS), return_hydra_config=True)
             chosen = cfg.hydra.runtime.choices.get(family)
     config = plugin_config_class(family, chosen) if chosen else None
     return valid_keys(config) if config else []
@@ -109,7 +110,8 @@ def _compose(overrides: list[str]):
 
     try:
         with initialize_config_dir(config_dir=str(CONF_DIR), version_base=VERSION_BASE):
-            cfg = compose("config", overrides=overrides, return_hydra_config=True)
+            cfg = compose("config", overrides=overrides + searchpath_override(USER_CONFIG_DIRS),
+                          return_hydra_config=True)
             choices = {k: v for k, v in cfg.hydra.runtime.choices.items()
                        if not k.startswith("hydra")}
             sweeper = OmegaConf.to_container(cfg.hydra.sweeper, resolve=False)
@@ -261,6 +263,7 @@ def main(argv: list[str] | None = None) -> None:
         _record_early(overrides)
     chosen = chosen_plugins(overrides)
     try:
+        USER_CONFIG_DIRS[:] = user_config_dirs(argv)
         register_configs(chosen)
         _log_dropped_experiment_settings(overrides, chosen)
         if not info and check_composition(overrides, multirun) and not multirun:

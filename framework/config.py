@@ -15,16 +15,32 @@ from typing import Any
 
 from .registry import FAMILIES, describe, discover, load_all
 
-#: where the project's own config groups and experiment definitions live (editable install)
-PROJECT_ROOT = Path(__file__).resolve().parent.parent
-CONF_DIR = PROJECT_ROOT / "conf"
+_PACKAGE = Path(__file__).resolve().parent
+
+
+def _shipped(name: str) -> Path:
+    """``pointatlas/<name>`` of an installed wheel, else ``<checkout>/<name>`` (editable)."""
+    inside = _PACKAGE / name
+    return inside if inside.is_dir() else _PACKAGE.parent / name
+
+
+#: the project's own config groups (Hydra's primary config directory)
+CONF_DIR = _shipped("conf")
+#: the project's own experiment definitions
+EXPERIMENTS_DIR = _shipped("experiments")
+#: config directories the user added (``--config-dir``, ``hydra.searchpath``), set by the CLI;
+#: their ``experiment/`` folders hold the user's experiments
+USER_CONFIG_DIRS: list[Path] = []
 
 
 def experiments_dirs() -> list[Path]:
-    """Folders whose ``*.yaml`` files are experiment definitions (``POINTATLAS_EXPERIMENTS``
-    adds more, separated by ``os.pathsep``)."""
+    """Folders whose ``*.yaml`` files are experiment definitions: the shipped ones, the
+    ``experiment/`` folder of each user config directory (``--config-dir``,
+    ``hydra.searchpath``), then ``POINTATLAS_EXPERIMENTS`` (folders separated by
+    ``os.pathsep``, for Python callers that compose without the CLI). A later folder's
+    experiment replaces a shipped one of the same name."""
     extra = [Path(p) for p in os.environ.get("POINTATLAS_EXPERIMENTS", "").split(os.pathsep) if p]
-    return [PROJECT_ROOT / "experiments", *extra]
+    return [EXPERIMENTS_DIR, *(d / "experiment" for d in USER_CONFIG_DIRS), *extra]
 
 
 @dataclass
@@ -106,8 +122,15 @@ def register_configs(chosen: dict[str, str] | None = None) -> None:
                 )
                 continue
             cs.store(group=family, name=name, node=config, provider=discover(group)[name].distribution)
+    # a user's config folders are Hydra's to read (a stored config of the same name would be
+    # taken as its schema): store only the others, less any name a user folder redefines
+    users = {p.stem for d in USER_CONFIG_DIRS for p in (d / "experiment").glob("*.yaml")}
     for folder in experiments_dirs():
+        if folder.parent in USER_CONFIG_DIRS and folder.name == "experiment":
+            continue
         for path in sorted(folder.glob("*.yaml")):
+            if path.stem in users:
+                continue
             node = OmegaConf.load(path)
             for family, name in (chosen or {}).items():
                 block = node.get(family)

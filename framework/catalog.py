@@ -41,8 +41,12 @@ SCHEMA_VERSION = 2
 #: File name of the catalog inside the outputs root.
 CATALOG_FILENAME = "catalog.sqlite"
 #: Statuses stored in the catalog; "missing" is computed when the run directory is gone, and
-#: "died" for a run recorded as running whose process no longer exists.
-STATUSES = ("running", "completed", "completed_with_warnings", "failed")
+#: "died" for a run recorded as running whose process no longer exists. "rejected": the command
+#: line was refused at start-up (a typo, a bad value) before any work; such rows are hidden
+#: unless asked for (``status="rejected"`` or ``include_rejected=True``).
+STATUSES = ("running", "completed", "completed_with_warnings", "failed", "rejected")
+REJECTED = "rejected"
+_FINISHED = ("completed", "completed_with_warnings", "failed", REJECTED)
 
 
 _SCHEMA = """
@@ -142,10 +146,11 @@ class Catalog:
 
     def finish(self, run_id: str, *, status: str, end_time: str, wall_time_s: float,
                metrics: dict[str, float], error: str | None = None) -> None:
-        """Record the end of a started run: status ("completed"/"failed"), time and metrics."""
-        if status not in ("completed", "completed_with_warnings", "failed"):
-            raise ConfigError(f"finish status {status!r} is invalid: use 'completed', "
-                              "'completed_with_warnings' or 'failed'")
+        """Record the end of a started run: status ("completed"/"failed"/"rejected"), time and
+        metrics."""
+        if status not in _FINISHED:
+            raise ConfigError(f"finish status {status!r} is invalid: use one of "
+                              f"{', '.join(_FINISHED)}")
         values = _metric_rows(metrics)
 
         def write(conn: sqlite3.Connection) -> None:
@@ -179,8 +184,10 @@ class Catalog:
 
     def runs(self, *, experiment: str | None = None, status: str | None = None,
              where: Iterable[str] = (), metric: Iterable[str] = (),
-             limit: int | None = None) -> list[RunRecord]:
+             limit: int | None = None, include_rejected: bool = False) -> list[RunRecord]:
         """Runs matching every filter, oldest first (``limit``: keep only the newest N).
+        Command lines rejected at start-up are left out unless ``status="rejected"`` or
+        ``include_rejected``.
 
         ``status`` may be "missing" (the computed status of runs whose directory is gone).
         ``where``: ``key=value`` strings; ``metric``: ``name<op>value`` thresholds.
@@ -205,6 +212,7 @@ class Catalog:
         selected = [
             r for r in records
             if (status is None or r.status == status)
+            and (r.status != REJECTED or include_rejected or status == REJECTED)
             and all(f.matches(r) for f in where_filters)
             and all(f.matches(r) for f in metric_filters)
         ]

@@ -53,10 +53,16 @@ def _results_facts(path: Path) -> dict:
             if name in nc.variables and nc.variables[name].ndim == 0:
                 metrics[name] = float(nc.variables[name][...])
     plugins = json.loads(attrs.get("plugins", "{}"))
+    params = {**plugins, "seed": str(attrs.get("seed", ""))}
+    try:  # the resolved settings the run recorded beside its results
+        params = {**json.loads((path.parent / "run.json").read_text()).get("params", {}),
+                  **params}
+    except (OSError, ValueError, AttributeError):
+        pass
     return {
         "run_id": str(attrs["run_id"]), "experiment": str(attrs.get("experiment", "default")),
         "overrides": json.loads(attrs.get("overrides", "[]")),
-        "params": {**plugins, "seed": str(attrs.get("seed", ""))},
+        "params": params,
         "git_commit": str(attrs.get("git_commit", "")),
         "start_time": str(attrs.get("start_time", "")), "end_time": str(attrs.get("end_time", "")),
         "wall_time_s": float(attrs.get("wall_time_s", float("nan"))), "metrics": metrics,

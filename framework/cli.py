@@ -167,9 +167,10 @@ def _task(cfg) -> None:
         choices=choices,
         overrides=list(hc.overrides.task),
         run_dir=hc.runtime.output_dir,
-        experiment=choices.get("experiment") or "default",
+        experiment=choices.get("experiment") or "none",
         config_yaml=OmegaConf.to_yaml(cfg, resolve=True),
         run_id=_EARLY.get("run_id") if hc.mode.name == "RUN" else _job_run_id(),
+        sweep_id=None if hc.mode.name == "RUN" else _job_sweep_id(),
     )
 
 
@@ -226,6 +227,12 @@ def _job_run_id() -> str | None:
     return JOB.get("run_id")
 
 
+def _job_sweep_id() -> str | None:
+    from .sweep_guard import JOB
+
+    return JOB.get("sweep_id") or None
+
+
 #: the run recorded by :func:`main` before any heavy import (single runs only)
 _EARLY: dict = {}
 
@@ -240,7 +247,10 @@ def _record_early(overrides: list[str]) -> None:
     root = next((o.split("=", 1)[1] for o in overrides if o.startswith("outputs_root=")),
                 "outputs")
     experiment = next((o.split("=", 1)[1] for o in overrides if o.startswith("experiment=")),
-                      "default")
+                      None)
+    if experiment is None:
+        dropped = any(o.startswith("~experiment") for o in overrides)
+        experiment = "none" if dropped else (_default_experiment() or "none")
     if Path(root).exists() and not Path(root).is_dir():
         return  # refused by the start-up check, with the fix
     record = RunRecorder(root, new_run_id())
@@ -275,7 +285,7 @@ def main(argv: list[str] | None = None) -> None:
         if "record" not in _EARLY:
             _record_early(overrides)
         if "record" in _EARLY:
-            _EARLY["record"].failed(wall_time_s=None, error=str(exc))
+            _EARLY["record"].rejected(error=str(exc))
         sys.exit(2)
     import hydra
 
@@ -299,6 +309,12 @@ def main(argv: list[str] | None = None) -> None:
         sys.exit(1)
     if code:
         sys.exit(code)
+    if sweep_guard.CURRENT.get("sweep_dir") is not None:
+        from .sweep import write_sweep
+
+        path = write_sweep(sweep_guard.CURRENT["sweep_dir"], sweep_guard.CURRENT.get("sweep_id"))
+        if path is not None:
+            log.info("sweep %s: %s", sweep_guard.CURRENT.get("sweep_id") or "", path)
 
 
 def _task_safe(cfg) -> None:

@@ -19,6 +19,7 @@ from .results import (check_variables, metric_names, metric_values, write_result
                       write_text_atomic)
 from .run_files import ERROR_FILE, RESULTS_NAME, RUN_FILE, remove_partial_files
 from .liveness import identity
+from .run_filters import flatten_settings
 from .run_record import RunRecorder
 
 log = logging.getLogger("pointatlas.run")
@@ -38,7 +39,8 @@ def seed_everything(seed: int) -> None:
 
 
 def run_study(*, config: dict, choices: dict[str, str], overrides: list[str], run_dir: Path,
-              experiment: str = "default", config_yaml: str = "", run_id: str | None = None) -> Path:
+              experiment: str = "default", config_yaml: str = "", run_id: str | None = None,
+              sweep_id: str | None = None) -> Path:
     """Run the selected study and write ``run_dir/results.nc``; record it in the catalog.
 
     Parameters
@@ -47,6 +49,7 @@ def run_study(*, config: dict, choices: dict[str, str], overrides: list[str], ru
     choices : family -> plugin name selected for the run (``study`` is required)
     overrides : the command-line overrides of this run (for the catalog and sweeps)
     run_id : the id under which the command line already recorded this run (a new one if None)
+    sweep_id : the sweep this run is a job of (a ``sweep`` setting in the catalog, an attr)
 
     A study that sets ``ds.attrs["warnings"]`` (results it cannot fully vouch for, e.g. an
     atlas with patches that failed the chart test, allowed by the user) is recorded as
@@ -64,13 +67,14 @@ def run_study(*, config: dict, choices: dict[str, str], overrides: list[str], ru
     record = RunRecorder(config.get("outputs_root", "outputs"), run_id)
     commit, start = git_commit(), now_iso()
     plugins = {f: n for f, n in choices.items() if f in PLUGIN_FAMILIES and n}
+    params = {**flatten_settings(config), **plugins, "seed": str(seed),
+              **({"sweep": sweep_id} if sweep_id else {})}
     record.start(experiment=experiment, overrides=list(overrides), path=str(run_dir.resolve()),
-                 git_commit=commit, start_time=start,
-                 params={**{f: n for f, n in plugins.items()}, "seed": str(seed)})
+                 git_commit=commit, start_time=start, params=params)
     record.start_heartbeat()
     write_text_atomic(run_dir / RUN_FILE, json.dumps({
         "run_id": run_id, "experiment": experiment, "overrides": list(overrides),
-        "params": {**plugins, "seed": str(seed)}, "git_commit": commit, "start_time": start,
+        "params": params, "git_commit": commit, "start_time": start,
         **identity()}, indent=1) + "\n")
     t0 = time.perf_counter()
     if config.get("quiet"):
@@ -106,6 +110,7 @@ def run_study(*, config: dict, choices: dict[str, str], overrides: list[str], ru
             "end_time": now_iso(),
             "run_id": run_id,
             "experiment": experiment,
+            "sweep_id": sweep_id or "",
             "study": plugins["study"],
             "plugins": plugins,
             "metrics": metric_names(ds),
@@ -123,6 +128,9 @@ def run_study(*, config: dict, choices: dict[str, str], overrides: list[str], ru
     shown = ", ".join(f"{k}={v:.6g}" for k, v in metrics.items() if not k.startswith("time_"))
     log.info("run %s completed in %.2f s: %s", run_id, wall, shown)
     log.info("results: %s", path)
+    root = Path(config.get("outputs_root", "outputs")).resolve()
+    log.info("outputs root: %s (catalog %s; `pointatlas-runs list --root %s`)", root,
+             root / "catalog.sqlite", root)
     return path
 
 

@@ -38,7 +38,12 @@ class WhereFilter:
         if self.key == "experiment" and _same_value(record.experiment, self.value):
             return True
         settings = record.settings()
-        return self.key in settings and _same_value(settings[self.key], self.value)
+        if self.key in settings:
+            return _same_value(settings[self.key], self.value)
+        # a key without its group (``n_points`` for ``source.n_points``) matches the
+        # resolved settings that end with it
+        return any(_same_value(v, self.value) for k, v in settings.items()
+                   if k.endswith("." + self.key))
 
 
 @dataclass(frozen=True)
@@ -79,6 +84,23 @@ def parse_metric(text: str) -> MetricFilter:
             f"bad metric filter {text!r}: {raw!r} is not a number; expected {METRIC_SYNTAX}"
         ) from None
     return MetricFilter(name, op, value)
+
+
+def flatten_settings(config: dict, prefix: str = "", limit: int = 200) -> dict[str, str]:
+    """The resolved run config as ``dotted.key -> value`` strings, the way an override spells
+    them (``true``, ``null``, ``[1, 2]``), so that the catalog filters and compares what a run
+    used, defaults included. Values longer than ``limit`` characters are left out."""
+    out: dict[str, str] = {}
+    for key, value in (config or {}).items():
+        name = f"{prefix}{key}"
+        if isinstance(value, dict):
+            out.update(flatten_settings(value, name + ".", limit))
+            continue
+        text = ("null" if value is None else str(value).lower() if isinstance(value, bool)
+                else repr(value) if isinstance(value, float) else str(value))
+        if len(text) <= limit:
+            out[name] = text
+    return out
 
 
 def overrides_as_dict(overrides: Iterable[str]) -> dict[str, str]:

@@ -96,6 +96,13 @@ class RunRecorder:
                    end_time=now_iso(), wall_time_s=wall_time_s, metrics=metrics,
                    error=warnings or None)
 
+    def rejected(self, *, error: str) -> None:
+        """The command line was refused at start-up, before any work: not a run that failed
+        (hidden from ``pointatlas-runs list`` unless asked for)."""
+        self.stop_heartbeat()
+        self._call("finish", self.run_id, status="rejected", end_time=now_iso(),
+                   wall_time_s=float("nan"), metrics={}, error=error)
+
     def failed(self, *, wall_time_s: float | None, error: str) -> None:
         self.stop_heartbeat()
         self._call("finish", self.run_id, status="failed", end_time=now_iso(),

@@ -6,8 +6,15 @@ Subcommands::
                          [--metric 'name<value' ...] [--format table|json] [--limit N]
     pointatlas-runs show ID [--format table|json]
     pointatlas-runs compare ID ID [...] [--format table|json]
+    pointatlas-runs rm ID [...] [--keep-files]   remove runs (their directories too)
+    pointatlas-runs rerun ID          run the same experiment with the same overrides again
     pointatlas-runs repair            rebuild the catalog from the run directories
     pointatlas-runs gc                remove the temporary files killed writes left behind
+
+``list`` leaves out command lines rejected at start-up (``--status rejected`` or ``--all``
+shows them). Filters and ``compare`` see each run's resolved settings (defaults included),
+and ``--where n_points=441`` matches ``source.n_points``. Numbers get the significant figures
+that tell the listed runs apart (at least 4), or ``--digits N``.
 
 A run recorded as running whose process is gone (killed, out of memory, a lost node) is
 listed as ``died``.
@@ -19,23 +26,19 @@ exit non-zero; ``--format json`` prints only JSON on stdout. Standard library on
 from __future__ import annotations
 
 import argparse
-import json
-import math
 import os
 import sqlite3
 import sys
-from dataclasses import asdict
 from pathlib import Path
 from typing import Sequence
 
-from .catalog import (DIED, METRIC_SYNTAX, MISSING, STATUSES, WHERE_SYNTAX, Catalog, RunRecord,
-                      catalog_path)
+from .catalog import DIED, METRIC_SYNTAX, MISSING, STATUSES, WHERE_SYNTAX, Catalog, catalog_path
 from .errors import PointatlasError
+from .runs_format import (clip, duration, finite, metric_digits, metrics_cell, number,
+                          record_json, short_ids, short_time, table, to_json)
 
 PROG = "pointatlas-runs"
 ENV_ROOT = "POINTATLAS_OUTPUTS"
-_SHORT_ID = 8
-_CELL_MAX = 60
 
 
 class _UsageError(Exception):
@@ -55,7 +58,10 @@ def build_parser() -> argparse.ArgumentParser:
     common.add_argument("--root", default=argparse.SUPPRESS,
                         help=f"outputs root holding catalog.sqlite (default: ${ENV_ROOT} or ./outputs)")
     common.add_argument("--format", choices=("table", "json"), default="table", help="output format")
-    sub = parser.add_subparsers(dest="command", metavar="{list,show,compare,repair,gc}",
+    common.add_argument("--digits", type=_positive, default=None, metavar="N",
+                        help="significant figures of numbers (default: enough to tell runs apart)")
+    sub = parser.add_subparsers(dest="command",
+                                metavar="{list,show,compare,rm,rerun,repair,gc}",
                                 parser_class=_Parser)
     sub.required = True
 
@@ -69,12 +75,22 @@ def build_parser() -> argparse.ArgumentParser:
                          help=f"metric threshold, repeatable: {METRIC_SYNTAX}")
     listing.add_argument("--limit", type=_non_negative, default=None, metavar="N",
                          help="show only the N most recent matching runs")
+    listing.add_argument("--all", action="store_true",
+                         help="also the command lines rejected at start-up")
 
     show = sub.add_parser("show", parents=[common], help="every field of one run")
     show.add_argument("run_id", metavar="ID", help="run id or unique prefix")
 
     compare = sub.add_parser("compare", parents=[common], help="runs side by side")
     compare.add_argument("run_ids", metavar="ID", nargs="+", help="two or more run ids or prefixes")
+    remove = sub.add_parser("rm", parents=[common], help="remove runs from the catalog and "
+                            "delete their run directories")
+    remove.add_argument("run_ids", metavar="ID", nargs="+", help="run ids or unique prefixes")
+    remove.add_argument("--keep-files", action="store_true",
+                        help="keep the run directories, remove only the catalog rows")
+    rerun = sub.add_parser("rerun", parents=[common], help="run a recorded run's experiment "
+                           "and overrides again (a new run)")
+    rerun.add_argument("run_id", metavar="ID", help="run id or unique prefix")
     sub.add_parser("repair", parents=[common], help="move a damaged catalog aside and rebuild "
                    "it from the results.nc / run.json files under the root")
     sub.add_parser("gc", parents=[common], help="remove the temporary files (.results.nc.*.tmp, "
@@ -93,10 +109,12 @@ def main(argv: Sequence[str] | None = None) -> int:
             raise _UsageError("compare needs at least two run ids")
         if args.command in ("repair", "gc"):
             output = _cmd_repair(args) if args.command == "repair" else _cmd_gc(args)
+        elif args.command == "rerun":
+            return _cmd_rerun(_open_catalog(_root(args.root)), args)
         else:
             catalog = _open_catalog(_root(args.root))
-            output = {"list": _cmd_list, "show": _cmd_show,
-                      "compare": _cmd_compare}[args.command](catalog, args)
+            output = {"list": _cmd_list, "show": _cmd_show, "compare": _cmd_compare,
+                      "rm": _cmd_rm}[args.command](catalog, args)
         sys.stdout.write(output if output.endswith("\n") else output + "\n")
         sys.stdout.flush()
         return 0
@@ -133,6 +151,13 @@ def _silence_stdout() -> None:
         pass
 
 
+def _positive(text: str) -> int:
+    value = _non_negative(text)
+    if not 1 <= value <= 17:
+        raise argparse.ArgumentTypeError(f"{value} is out of range: use 1 <= N <= 17")
+    return value
+
+
 def _non_negative(text: str) -> int:
     try:
         value = int(text)
@@ -159,29 +184,30 @@ def _open_catalog(root: Path) -> Catalog:
 
 def _cmd_list(catalog: Catalog, args: argparse.Namespace) -> str:
     records = catalog.runs(experiment=args.experiment, status=args.status, where=args.where,
-                           metric=args.metric, limit=args.limit)
+                           metric=args.metric, limit=args.limit, include_rejected=args.all)
     if args.format == "json":
-        return _json([_record_json(r) for r in records])
+        return to_json([record_json(r) for r in records])
     if not records:
         return "no runs match"
     short = short_ids(catalog.ids())
+    digits = metric_digits(records, args.digits)
     header = ["id", "experiment", "status", "start", "wall time", "overrides", "metrics"]
-    rows = [[short.get(r.id, r.id), r.experiment, r.status, _time(r.start_time),
-             _duration(r.wall_time_s), _clip(" ".join(r.overrides)), _clip(_metrics_cell(r.metrics))]
-            for r in records]
-    return _table(header, rows)
+    rows = [[short.get(r.id, r.id), r.experiment, r.status, short_time(r.start_time),
+             duration(r.wall_time_s), clip(" ".join(r.overrides)),
+             clip(metrics_cell(r.metrics, digits))] for r in records]
+    return table(header, rows)
 
 
 def _cmd_show(catalog: Catalog, args: argparse.Namespace) -> str:
     record = catalog.get(args.run_id)
     if args.format == "json":
-        return _json(_record_json(record))
+        return to_json(record_json(record))
     lines = [
         ("id", record.id), ("experiment", record.experiment),
         ("status", record.status if record.status == record.recorded_status
          else f"{record.status} (recorded: {record.recorded_status})"),
         ("start", record.start_time or "-"), ("end", record.end_time or "-"),
-        ("wall time", _duration(record.wall_time_s)), ("path", record.path or "-"),
+        ("wall time", duration(record.wall_time_s)), ("path", record.path or "-"),
         ("git commit", record.git_commit or "-"), ("error", record.error or "-"),
         ("process", f"{record.pid} on {record.host}" if record.pid else "-"),
         ("heartbeat", record.heartbeat or "-"),
@@ -195,7 +221,8 @@ def _cmd_show(catalog: Catalog, args: argparse.Namespace) -> str:
     out.append("metrics:" + ("" if record.metrics else " -"))
     if record.metrics:
         name_width = max(len(n) for n in record.metrics)
-        out += [f"  {n:<{name_width}}  {_number(v)}" for n, v in sorted(record.metrics.items())]
+        out += [f"  {n:<{name_width}}  {number(v, args.digits or 6)}"
+                for n, v in sorted(record.metrics.items())]
     return "\n".join(out)
 
 
@@ -208,33 +235,72 @@ def _cmd_compare(catalog: Catalog, args: argparse.Namespace) -> str:
     names = sorted({n for r in records for n in r.metrics})
     metrics = {n: [r.metrics.get(n) for r in records] for n in names}
     if args.format == "json":
-        return _json({
+        return to_json({
             "runs": [r.id for r in records],
             "experiment": [r.experiment for r in records],
             "status": [r.status for r in records],
-            "wall_time_s": [_finite(r.wall_time_s) for r in records],
+            "wall_time_s": [finite(r.wall_time_s) for r in records],
             "git_commit": [r.git_commit for r in records],
             "differing": differing,
-            "metrics": {n: [_finite(v) for v in values] for n, values in metrics.items()},
+            "metrics": {n: [finite(v) for v in values] for n, values in metrics.items()},
         })
     short = short_ids(catalog.ids())
     header = [""] + [short.get(r.id, r.id) for r in records]
     rows = [["experiment"] + [r.experiment for r in records],
             ["status"] + [r.status for r in records],
-            ["start"] + [_time(r.start_time) for r in records],
-            ["wall time"] + [_duration(r.wall_time_s) for r in records]]
+            ["start"] + [short_time(r.start_time) for r in records],
+            ["wall time"] + [duration(r.wall_time_s) for r in records]]
     if len({r.git_commit for r in records}) > 1:
         rows.append(["git commit"] + [r.git_commit[:10] or "-" for r in records])
-    sections = [_table(header, rows)]
-    sections.append(_table(["differing setting"] + header[1:],
-                           [[k] + [_clip("-" if v is None else v) for v in vals]
+    digits = metric_digits(records, args.digits)
+    sections = [table(header, rows)]
+    sections.append(table(["differing setting"] + header[1:],
+                          [[k] + [clip("-" if v is None else v) for v in vals]
                             for k, vals in differing.items()])
                     if differing else "differing settings: none")
-    sections.append(_table(["metric"] + header[1:],
-                           [[n] + ["-" if v is None else _number(v) for v in vals]
+    sections.append(table(["metric"] + header[1:],
+                          [[n] + [number(v, digits[n]) for v in vals]
                             for n, vals in metrics.items()])
                     if metrics else "metrics: none")
     return "\n\n".join(sections)
+
+
+def _cmd_rm(catalog: Catalog, args: argparse.Namespace) -> str:
+    import shutil
+
+    records = [catalog.get(run_id) for run_id in args.run_ids]
+    running = [r for r in records if r.status == "running"]
+    if running:
+        raise PointatlasError(f"run {running[0].id} is still running (pid {running[0].pid} on "
+                              f"{running[0].host}): stop it first, then remove it")
+    removed = []
+    for record in records:
+        folder = Path(record.path) if record.path else None
+        if not args.keep_files and folder and folder.is_dir() and (
+                (folder / "run.json").exists() or (folder / "results.nc").exists()):
+            shutil.rmtree(folder)
+        catalog.forget(record.id)
+        removed.append({"id": record.id, "path": record.path,
+                        "files_removed": bool(folder) and not args.keep_files})
+    if args.format == "json":
+        return to_json({"removed": removed})
+    return "\n".join(f"removed {r['id']}" + (f" and {r['path']}" if r["files_removed"] else "")
+                     for r in removed)
+
+
+def _cmd_rerun(catalog: Catalog, args: argparse.Namespace) -> int:
+    """Run ``pointatlas`` with the recorded experiment and overrides (and this outputs root)."""
+    import subprocess
+
+    record = catalog.get(args.run_id)
+    overrides = [o for o in record.overrides if not o.startswith(("outputs_root=", "experiment="))]
+    experiment = ([f"experiment={record.experiment}"] if record.experiment != "none"
+                  else ["~experiment"])
+    command = [str(Path(sys.executable).parent / "pointatlas"), *experiment, *overrides,
+               f"outputs_root={_root(args.root)}"]
+    print(f"{PROG}: rerunning {record.id}: pointatlas {' '.join(command[1:])}", file=sys.stderr,
+          flush=True)
+    return subprocess.call(command)
 
 
 def _existing_root(args: argparse.Namespace) -> Path:
@@ -250,7 +316,7 @@ def _cmd_repair(args: argparse.Namespace) -> str:
     root = _existing_root(args)
     report = rebuild_catalog(root)
     if args.format == "json":
-        return _json({"catalog": str(catalog_path(root)), "moved_aside": list(map(str, report.moved_aside)),
+        return to_json({"catalog": str(catalog_path(root)), "moved_aside": list(map(str, report.moved_aside)),
                       "completed": report.completed, "failed": report.failed,
                       "unfinished": report.unfinished,
                       "unreadable": list(map(str, report.unreadable))})
@@ -263,78 +329,9 @@ def _cmd_gc(args: argparse.Namespace) -> str:
     root = _existing_root(args)
     removed = collect_garbage(root)
     if args.format == "json":
-        return _json({"removed": list(map(str, removed))})
+        return to_json({"removed": list(map(str, removed))})
     return f"removed {len(removed)} leftover temporary files under {root}" + "".join(
         f"\n  {p}" for p in removed)
-
-
-# ----------------------------------------------------------------------------- formatting
-
-
-def short_ids(ids: Sequence[str], minimum: int = _SHORT_ID) -> dict[str, str]:
-    """Shortest prefix (at least ``minimum`` characters) that identifies each id uniquely."""
-    ordered = sorted(set(ids))
-    result = {}
-    for i, run_id in enumerate(ordered):
-        common = 0
-        for neighbour in ordered[max(i - 1, 0):i] + ordered[i + 1:i + 2]:
-            common = max(common, len(os.path.commonprefix([run_id, neighbour])))
-        result[run_id] = run_id[:max(minimum, common + 1)]
-    return result
-
-
-def _table(header: list[str], rows: list[list[str]]) -> str:
-    widths = [max(len(str(row[i])) for row in [header, *rows]) for i in range(len(header))]
-    lines = ["  ".join(str(cell).ljust(w) for cell, w in zip(row, widths)).rstrip()
-             for row in [header, [("-" * w) for w in widths], *rows]]
-    return "\n".join(lines)
-
-
-def _clip(text: str, limit: int = _CELL_MAX) -> str:
-    return text if len(text) <= limit else text[:limit - 3] + "..."
-
-
-def _metrics_cell(metrics: dict[str, float]) -> str:
-    return " ".join(f"{name}={_number(value)}" for name, value in metrics.items())
-
-
-def _number(value: float | None) -> str:
-    return "-" if value is None else f"{value:.4g}"
-
-
-def _time(iso: str | None) -> str:
-    if not iso:
-        return "-"
-    text = iso.replace("T", " ")
-    return text[:19]
-
-
-def _duration(seconds: float | None) -> str:
-    if seconds is None or not math.isfinite(seconds):
-        return "-"
-    if seconds < 60:
-        return f"{seconds:.1f} s"
-    minutes, secs = divmod(int(round(seconds)), 60)
-    if minutes < 60:
-        return f"{minutes}m {secs:02d}s"
-    hours, minutes = divmod(minutes, 60)
-    return f"{hours}h {minutes:02d}m"
-
-
-def _finite(value: float | None) -> float | None:
-    return value if value is not None and math.isfinite(value) else None
-
-
-def _record_json(record: RunRecord) -> dict:
-    data = asdict(record)
-    data["wall_time_s"] = _finite(record.wall_time_s)
-    data["metrics"] = {n: _finite(v) for n, v in record.metrics.items()}
-    return data
-
-
-def _json(data) -> str:
-    """Strict JSON (non-finite numbers are written as null)."""
-    return json.dumps(data, indent=2, allow_nan=False)
 
 
 if __name__ == "__main__":

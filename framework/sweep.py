@@ -50,8 +50,41 @@ def swept_parameters(overrides: list[list[str]]) -> list[str]:
     return sorted(keys)
 
 
+SWEEP_FILE = "sweep.nc"
+
+
+def _fresh_sweep_file(sweep_dir: Path, dirs: list[Path]) -> Path | None:
+    """``sweep.nc`` if it is newer than every job's results (a job rerun since makes it stale)."""
+    path = sweep_dir / SWEEP_FILE
+    if not path.is_file():
+        return None
+    written = path.stat().st_mtime
+    return path if all((d / RESULTS_NAME).stat().st_mtime <= written for d in dirs) else None
+
+
+def write_sweep(path: str | os.PathLike, sweep_id: str | None = None) -> Path | None:
+    """Write the combined Dataset of a finished multirun to ``<sweep dir>/sweep.nc`` (to a
+    temporary name, then renamed), so it is not assembled again on each read. None when the
+    directory holds no finished job."""
+    sweep_dir = Path(path)
+    if not run_dirs(sweep_dir):
+        return None
+    ds = _assemble(sweep_dir)
+    if sweep_id:
+        ds.attrs["sweep_id"] = sweep_id
+    out = sweep_dir / SWEEP_FILE
+    tmp = sweep_dir / f".{SWEEP_FILE}.{os.getpid()}.tmp"
+    try:
+        ds.to_netcdf(tmp)
+        os.replace(tmp, out)
+    finally:
+        tmp.unlink(missing_ok=True)
+    return out
+
+
 def open_sweep(path: str | os.PathLike) -> xr.Dataset:
-    """One Dataset for a multirun directory.
+    """One Dataset for a multirun directory: its ``sweep.nc`` when the sweep finished (and no
+    job was rerun since), else assembled from the jobs' results.
 
     When the runs form a full grid over the swept override keys, those keys are dimensions
     (e.g. ``source.n_points``); otherwise runs are stacked along a ``run`` dim with the swept
@@ -64,6 +97,16 @@ def open_sweep(path: str | os.PathLike) -> xr.Dataset:
             f"no runs with {RESULTS_NAME} under {sweep_dir}. Pass the directory of a "
             "`pointatlas --multirun` sweep (it holds one numbered folder per job)."
         )
+    fresh = _fresh_sweep_file(sweep_dir, dirs)
+    if fresh is not None:
+        ds = xr.open_dataset(fresh)
+        ds.attrs["sweep_dir"] = str(sweep_dir)
+        return ds
+    return _assemble(sweep_dir)
+
+
+def _assemble(sweep_dir: Path) -> xr.Dataset:
+    dirs = run_dirs(sweep_dir)
     runs = [open_run(d) for d in dirs]
     overrides = [json.loads(ds.attrs.get("overrides", "[]")) for ds in runs]
     keys = swept_parameters(overrides)

@@ -57,12 +57,14 @@ class SweepGuard(_Callback):
         try:
             listed = json.loads((Path(str(hc.sweep.dir)) / JOBS_FILE).read_text())
             run_id = listed["run_ids"][int(hc.job.num)]
+            sweep_id = str(listed.get("sweep_id", ""))
         except (OSError, ValueError, KeyError, IndexError):
             return  # not a sweep this guard started: the job records itself when it starts
         _record_job(str(config.get("outputs_root", "outputs")), run_id,
                     list(hc.overrides.task), str(hc.runtime.output_dir),
                     str(hc.runtime.choices.get("experiment") or "default"))
         JOB["run_id"] = run_id
+        JOB["sweep_id"] = sweep_id
 
     def on_multirun_start(self, config, **kwargs) -> None:
         from omegaconf import OmegaConf
@@ -82,8 +84,9 @@ class SweepGuard(_Callback):
         from .run import new_run_id
 
         run_ids = [new_run_id() for _ in jobs]
-        write_text_atomic(sweep_dir / JOBS_FILE,
-                          json.dumps({"jobs": jobs, "run_ids": run_ids}, indent=1) + "\n")
+        CURRENT["sweep_id"] = "sweep-" + new_run_id()
+        write_text_atomic(sweep_dir / JOBS_FILE, json.dumps(
+            {"sweep_id": CURRENT["sweep_id"], "jobs": jobs, "run_ids": run_ids}, indent=1) + "\n")
         # every job has its row from now on, held by this process until a worker takes it:
         # a job whose worker dies before it records itself reads as 'died' once the sweep ends
         root = str(config.get("outputs_root", "outputs"))

@@ -61,7 +61,7 @@ def test_misspelt_key_fails_before_work_listing_valid_keys(tmp_path, run_cli):
     assert "Unknown config key 'embedder.n_neigbors'" in proc.stderr
     assert "n_neighbors" in proc.stderr and "Traceback" not in proc.stderr
     assert not (tmp_path / "outputs" / "runs").exists()
-    assert [r["status"] for r in catalog_rows(tmp_path / "outputs")] == ["failed"]
+    assert [r["status"] for r in catalog_rows(tmp_path / "outputs")] == ["rejected"]
 
 
 def test_unknown_plugin_lists_installed(tmp_path, run_cli):
@@ -75,12 +75,12 @@ def test_wrong_type_is_named(tmp_path, run_cli):
     assert proc.returncode == 2 and "seed=abc" in proc.stderr and "Integer" in proc.stderr
 
 
-def test_missing_input_file_is_a_clear_failure_recorded_in_catalog(tmp_path, run_cli):
+def test_missing_input_file_is_refused_and_recorded_as_rejected(tmp_path, run_cli):
     proc = run_cli("pointatlas", "source=file", f"source.path={tmp_path}/nope.npz", cwd=tmp_path)
     assert proc.returncode == 2  # refused at start-up: no run directory
     assert "nope.npz" in proc.stderr and "Traceback" not in proc.stderr
     rows = catalog_rows(tmp_path / "outputs")
-    assert rows[0]["status"] == "failed" and "nope.npz" in rows[0]["error"]
+    assert rows[0]["status"] == "rejected" and "nope.npz" in rows[0]["error"]
     assert not list((tmp_path / "outputs").rglob("results.nc"))
     assert not (tmp_path / "outputs" / "runs").exists()
 

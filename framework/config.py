@@ -8,6 +8,7 @@ experiment definitions of ``experiments/`` under the group ``experiment``.
 from __future__ import annotations
 
 import dataclasses
+import enum
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -43,6 +44,13 @@ def experiments_dirs() -> list[Path]:
     return [EXPERIMENTS_DIR, *(d / "experiment" for d in USER_CONFIG_DIRS), *extra]
 
 
+class Tracking(enum.StrEnum):
+    """Values of the top-level key ``tracking`` (a misspelt one is refused at start-up)."""
+
+    none = "none"
+    mlflow = "mlflow"
+
+
 @dataclass
 class RunConfig:
     """Top-level keys of every run (the plugin groups are filled by the defaults list)."""
@@ -64,6 +72,12 @@ class RunConfig:
     title: str = ""
     #: experiment-specific settings (reference values, lists of embedders...)
     extra: dict = dataclasses.field(default_factory=dict)
+    #: mirror the run into an experiment tracker: none, or mlflow (pointatlas.mlflow_tracking)
+    tracking: Tracking = Tracking.none
+    #: the MLflow store ('' = $MLFLOW_TRACKING_URI, else ./mlruns); e.g. file:/abs/mlruns
+    tracking_uri: str = ""
+    #: the MLflow experiment ('' = the pointatlas experiment's name)
+    tracking_experiment: str = ""
 
 
 def valid_keys(config_class: type) -> list[str]:

@@ -91,6 +91,9 @@ def check_run_config(config: Mapping[str, Any], choices: Mapping[str, str]) -> N
     """Refuse a composed run config that cannot run (see the module docstring)."""
     check_seed(config.get("seed", 0))
     check_outputs_root(config.get("outputs_root", "outputs"))
+    from .mlflow_tracking import check_tracking
+
+    check_tracking(config)  # tracking=mlflow without mlflow: refused here, one line
     for family in FAMILIES.values():
         name = choices.get(family)
         if not name:

@@ -19,6 +19,7 @@ from .results import (check_variables, metric_names, metric_values, write_result
                       write_text_atomic)
 from .run_files import ERROR_FILE, RESULTS_NAME, RUN_FILE, remove_partial_files
 from .liveness import identity
+from .mlflow_tracking import mirror_run
 from .run_filters import flatten_settings
 from .run_record import RunRecorder
 
@@ -76,6 +77,8 @@ def run_study(*, config: dict, choices: dict[str, str], overrides: list[str], ru
         "run_id": run_id, "experiment": experiment, "overrides": list(overrides),
         "params": params, "git_commit": commit, "start_time": start,
         **identity()}, indent=1) + "\n")
+    tracked = dict(run_id=run_id, run_dir=run_dir, experiment=experiment, choices=choices,
+                   overrides=list(overrides), start_time=start)
     t0 = time.perf_counter()
     if config.get("quiet"):
         logging.getLogger("pointatlas").setLevel(logging.WARNING)
@@ -123,11 +126,13 @@ def run_study(*, config: dict, choices: dict[str, str], overrides: list[str], ru
             f"{type(exc).__name__}: {exc}\n{traceback.format_exc()}")
         record.failed(wall_time_s=time.perf_counter() - t0, error=message or type(exc).__name__)
         write_text_atomic(run_dir / ERROR_FILE, (message or type(exc).__name__) + "\n")
+        mirror_run(config, **tracked, error=message or type(exc).__name__)  # tracking=mlflow
         raise
     record.completed(wall_time_s=wall, metrics=metrics, warnings=str(ds.attrs.get("warnings") or ""))
     shown = ", ".join(f"{k}={v:.6g}" for k, v in metrics.items() if not k.startswith("time_"))
     log.info("run %s completed in %.2f s: %s", run_id, wall, shown)
     log.info("results: %s", path)
+    mirror_run(config, **tracked, metrics=metrics, warnings=str(ds.attrs.get("warnings") or ""))
     root = Path(config.get("outputs_root", "outputs")).resolve()
     log.info("outputs root: %s (catalog %s; `pointatlas-runs list --root %s`)", root,
              root / "catalog.sqlite", root)

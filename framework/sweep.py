@@ -87,8 +87,11 @@ def open_sweep(path: str | os.PathLike) -> xr.Dataset:
     job was rerun since), else assembled from the jobs' results.
 
     When the runs form a full grid over the swept override keys, those keys are dimensions
-    (e.g. ``source.n_points``); otherwise runs are stacked along a ``run`` dim with the swept
-    values as coordinates. Attrs come from the first run, plus ``sweep_params``.
+    named without dots (``source.n_points`` -> ``source_n_points``, the key in the
+    coordinate's ``override`` attr); otherwise runs are stacked along a ``run`` dim with the
+    swept values as coordinates. Variables that are integers in every run stay integers.
+    Attrs come from the first run, plus ``sweep_params`` (the dims), ``sweep_overrides`` (the
+    keys) and ``run_attrs`` (every run's attrs, JSON, in job order).
     """
     sweep_dir = Path(path)
     dirs = run_dirs(sweep_dir) if sweep_dir.is_dir() else []
@@ -105,6 +108,13 @@ def open_sweep(path: str | os.PathLike) -> xr.Dataset:
     return _assemble(sweep_dir)
 
 
+def dim_name(key: str, taken=()) -> str:
+    """The dimension name of a swept override key: ``source.n_points`` -> ``source_n_points``
+    (CF names have no dots); ``_swept`` appended if a results variable has that name."""
+    name = key.replace(".", "_").replace("/", "_")
+    return name + "_swept" if name in taken else name
+
+
 def _assemble(sweep_dir: Path) -> xr.Dataset:
     dirs = run_dirs(sweep_dir)
     runs = [open_run(d) for d in dirs]
@@ -115,14 +125,13 @@ def _assemble(sweep_dir: Path) -> xr.Dataset:
         [ds.drop_attrs(deep=False) for ds in runs],
         dim="run", coords="minimal", compat="override", join="outer",
     )
+    names = [dim_name(k, stacked.variables) for k in keys]
     stacked = stacked.assign_coords(run=("run", np.arange(len(runs)), {"long_name": "run index", "units": "1"}))
     stacked = stacked.assign_coords(
         run_dir=("run", [d.name for d in dirs], {"long_name": "run directory", "units": "1"})
     )
-    for i, key in enumerate(keys):
-        stacked = stacked.assign_coords(
-            {key: ("run", [v[i] for v in values], {"long_name": f"swept parameter {key}", "units": "1"})}
-        )
+    for i, (key, name) in enumerate(zip(keys, names)):
+        stacked = stacked.assign_coords({name: ("run", [v[i] for v in values])})
     axes = [sorted({v[i] for v in values}, key=str) for i in range(len(keys))]
     grid = set(itertools.product(*axes))
     is_grid = keys and len(grid) == len(values) and grid == {tuple(v) for v in values}
@@ -130,12 +139,34 @@ def _assemble(sweep_dir: Path) -> xr.Dataset:
     if is_grid:
         out = stacked.drop_vars("run_dir")
         if len(keys) == 1:
-            out = out.swap_dims(run=keys[0]).drop_vars("run").sortby(keys[0])
+            out = out.swap_dims(run=names[0]).drop_vars("run").sortby(names[0])
         else:
-            out = out.set_index(run=keys).unstack("run")
-        for key in keys:
-            out[key].attrs.update({"long_name": f"swept parameter {key}", "units": "1"})
+            out = out.set_index(run=names).unstack("run")
+    for key, name in zip(keys, names):
+        out[name].attrs.update({"long_name": f"swept parameter {key}", "units": "1",
+                                "override": key})
+    _restore_integers(out, runs)
     out.attrs = dict(runs[0].attrs)
-    out.attrs["sweep_params"] = json.dumps(keys)
+    out.attrs["sweep_params"] = json.dumps(names)
+    out.attrs["sweep_overrides"] = json.dumps(keys)
+    out.attrs["run_attrs"] = json.dumps([{"run_dir": d.name, **{k: _plain(v) for k, v in
+                                                                 ds.attrs.items()}}
+                                         for d, ds in zip(dirs, runs)])
     out.attrs["sweep_dir"] = str(sweep_dir)
     return out
+
+
+def _restore_integers(out: xr.Dataset, runs: list[xr.Dataset]) -> None:
+    """Variables that are integers in every run stay integers when stacking needed no
+    padding (no missing value)."""
+    for name in list(out.data_vars):
+        kinds = {ds[name].dtype for ds in runs if name in ds}
+        if len(kinds) == 1 and np.issubdtype(next(iter(kinds)), np.integer) and len(
+                [ds for ds in runs if name in ds]) == len(runs):
+            values = out[name].values
+            if np.issubdtype(values.dtype, np.floating) and np.all(np.isfinite(values)):
+                out[name] = out[name].astype(next(iter(kinds)))
+
+
+def _plain(value):
+    return value.tolist() if hasattr(value, "tolist") else value

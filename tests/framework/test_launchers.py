@@ -21,7 +21,7 @@ def test_two_job_sweep_is_cataloged(tmp_path, launcher, run_cli):
         rows = conn.execute("SELECT status, overrides FROM runs").fetchall()
     assert sorted(r[0] for r in rows) == ["completed", "completed"]
     ds = pointatlas.open_sweep(tmp_path / "sweep")
-    assert list(ds["source.n_points"].values) == [300, 400]
+    assert list(ds["source_n_points"].values) == [300, 400]
     assert ds["n_points"].values.tolist() == [300, 400]
 
 

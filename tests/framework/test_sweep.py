@@ -17,15 +17,19 @@ def test_grid_sweep_has_parameter_dims(tmp_path):
             fake_run(tmp_path / str(k), [f"source.n_points={n}", f"embedder={e}"], n * (1 + (e == "pca")))
             k += 1
     ds = pointatlas.open_sweep(tmp_path)
-    assert set(ds["err"].dims) == {"source.n_points", "embedder"}
-    assert float(ds["err"].sel({"source.n_points": 200, "embedder": "pca"})) == 400
+    assert set(ds["err"].dims) == {"source_n_points", "embedder"}
+    assert ds["source_n_points"].attrs["override"] == "source.n_points"
+    assert float(ds["err"].sel({"source_n_points": 200, "embedder": "pca"})) == 400
+    assert ds["err"].dtype.kind == "i"  # integers in every run, no padding: still integers
+    assert [r["overrides"] for r in __import__("json").loads(ds.attrs["run_attrs"])][0] == \
+        '["source.n_points=100", "embedder=pca"]' 
 
 
 def test_single_parameter_sweep(tmp_path):
     for k, n in enumerate((10, 20, 30)):
         fake_run(tmp_path / str(k), [f"source.n_points={n}"], 1.0 / n)
     ds = pointatlas.open_sweep(tmp_path)
-    assert ds["err"].dims == ("source.n_points",)
+    assert ds["err"].dims == ("source_n_points",)
     np.testing.assert_allclose(ds["err"].values, [0.1, 0.05, 1 / 30])
 
 

@@ -25,10 +25,11 @@ import math
 import os
 import re
 import tempfile
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Union
+from typing import Any
 
+from .headline import headline_rows
+from .report_blocks import Block, Details, Image, Pre, Report, Section, Table, Text  # noqa: F401
 from .registry import load_plugin
 from .report_figures import figure_to_png, metric_vs_param_figures, sweep_params, sweep_records
 
@@ -37,46 +38,6 @@ FORMATS = ("html", "md")
 
 _PROVENANCE = ("source", "git_commit", "hostname", "history", "seed", "start_time", "end_time",
                "wall_time_s", "status", "run_id", "pointatlas_schema", "Conventions")
-
-
-@dataclass(frozen=True)
-class Text:
-    text: str
-
-
-@dataclass(frozen=True)
-class Pre:
-    text: str
-
-
-@dataclass(frozen=True)
-class Table:
-    headers: tuple[str, ...]
-    rows: tuple[tuple[str, ...], ...]
-
-
-@dataclass(frozen=True)
-class Image:
-    title: str
-    png: bytes
-
-
-Block = Union[Text, Pre, Table, Image]
-
-
-@dataclass
-class Section:
-    heading: str
-    blocks: list[Block] = field(default_factory=list)
-
-
-@dataclass
-class Report:
-    title: str
-    sections: list[Section] = field(default_factory=list)
-
-    def images(self) -> list[Image]:
-        return [b for s in self.sections for b in s.blocks if isinstance(b, Image)]
 
 
 # --------------------------------------------------------------------------- formatting
@@ -111,7 +72,7 @@ def _json(ds, key: str, default: Any) -> Any:
 
 
 def what_was_run(ds, directory: Path | None, kind: str) -> list[Section]:
-    """Experiment, plugins, overrides, resolved config and provenance, from global attrs."""
+    """Experiment, plugins and overrides; provenance; the resolved config collapsed."""
     a = ds.attrs
     rows = [("experiment", a.get("experiment", "")), ("study", a.get("study", ""))]
     if directory is not None:
@@ -121,11 +82,26 @@ def what_was_run(ds, directory: Path | None, kind: str) -> list[Section]:
     overrides = _json(ds, "overrides", [])
     first = " (first run)" if kind == "sweep" else ""
     rows.append((f"overrides{first}", " ".join(str(o) for o in overrides) or "(none)"))
-    blocks: list[Block] = [Table(("item", "value"), tuple((k, format_value(v)) for k, v in rows))]
-    if a.get("config"):
-        blocks += [Text(f"Resolved configuration{first}:"), Pre(str(a["config"]).rstrip("\n"))]
+    sections = [Section("What was run", [Table(("item", "value"),
+                                               tuple((k, format_value(v)) for k, v in rows))])]
     prov = tuple((k, format_value(a[k])) for k in _PROVENANCE if k in a)
-    return [Section("What was run", blocks), Section(f"Provenance{first}", [Table(("attribute", "value"), prov)])]
+    sections.append(Section(f"Provenance{first}", [Table(("attribute", "value"), prov)]))
+    if a.get("config"):
+        sections.append(Section(f"Configuration{first}", [Details(
+            "resolved configuration (YAML)", str(a["config"]).rstrip("\n"))]))
+    return sections
+
+
+def headline_section(ds) -> Section | None:
+    """The run's result first: its headline metrics against their references."""
+    headers, rows = headline_rows(ds)
+    if not rows:
+        return None
+    failed = sum(r[6] == "FAIL" for r in rows)
+    judged = sum(r[6] in ("pass", "FAIL") for r in rows)
+    summary = (f"{judged - failed} of {judged} within the experiment's tolerance."
+               if judged else "No tolerance stated by the experiment.")
+    return Section("Result", [Table(headers, rows), Text(summary)])
 
 
 def metrics_table(ds) -> Table | None:
@@ -206,39 +182,45 @@ def plugin_figures(ds, hook: str) -> list[Block]:
 
 
 def build_run_report(ds, run_dir: str | os.PathLike | None = None) -> Report:
-    """Report of one run from its results Dataset (``run_dir`` only names the run)."""
+    """Report of one run from its results Dataset (``run_dir`` only names the run): the
+    result, the study's figures, all metrics, the data, then what was run and provenance."""
     title = str(ds.attrs.get("title") or f"pointatlas run {ds.attrs.get('run_id', '')}".strip())
-    report = Report(title, what_was_run(ds, Path(run_dir) if run_dir else None, "run"))
-    table = metrics_table(ds)
-    report.sections.append(Section("Metrics", [table] if table else [Text("No scalar metrics.")]))
+    report = Report(title)
+    headline = headline_section(ds)
+    if headline:
+        report.sections.append(headline)
     figures = plugin_figures(ds, "report_figures")
     report.sections.append(Section("Figures", figures or [Text("No plugin supplied figures.")]))
+    table = metrics_table(ds)
+    report.sections.append(Section("Metrics", [table] if table else [Text("No scalar metrics.")]))
     overview = data_overview(ds)
     if overview:
         report.sections.append(Section("Data", [overview]))
+    report.sections += what_was_run(ds, Path(run_dir) if run_dir else None, "run")
     return report
 
 
-def build_sweep_report(ds, sweep_dir: str | os.PathLike | None = None) -> Report:
-    """Report of a sweep from :func:`pointatlas.open_sweep`'s Dataset."""
+def build_sweep_report(ds, sweep_dir: str | os.PathLike | None = None,
+                       generic: bool = True) -> Report:
+    """Report of a sweep from :func:`pointatlas.open_sweep`'s Dataset: the study's sweep
+    figures first, the runs, then (``generic``) each metric that varies against each swept
+    numeric parameter, then what was run."""
     title = str(ds.attrs.get("title") or "pointatlas sweep")
-    report = Report(f"Sweep: {title}", what_was_run(ds, Path(sweep_dir) if sweep_dir else None, "sweep"))
+    report = Report(f"Sweep: {title}")
     params = sweep_params(ds)
     records = sweep_records(ds)
-    report.sections[0].blocks.insert(1, Text(
-        f"{len(records)} runs; swept parameters: {', '.join(params) or '(none)'}."))
+    intro = Text(f"{len(records)} runs; swept parameters: {', '.join(params) or '(none)'}.")
+    figures = plugin_figures(ds, "report_sweep_figures")
+    report.sections.append(Section("Figures", [intro, *figures] if figures else [intro]))
     report.sections.append(Section("Runs", [_records_table(records)] if records else [Text("No runs.")]))
     table = metrics_table(ds)
     if table:
         report.sections.append(Section("Sweep-wide metrics", [table]))
-    generic = []
-    for title_, fig in metric_vs_param_figures(ds):
-        generic.append(Image(title_, figure_to_png(fig)))
-    report.sections.append(Section("Metrics against swept parameters",
-                                   generic or [Text("No numeric swept parameter to plot against.")]))
-    figures = plugin_figures(ds, "report_sweep_figures")
-    if figures:
-        report.sections.append(Section("Experiment figures", figures))
+    if generic:
+        plots = [Image(t, figure_to_png(f)) for t, f in metric_vs_param_figures(ds)]
+        report.sections.append(Section("Metrics against swept parameters", plots or [
+            Text("No metric varies with a numeric swept parameter.")]))
+    report.sections += what_was_run(ds, Path(sweep_dir) if sweep_dir else None, "sweep")
     return report
 
 
@@ -252,10 +234,15 @@ def _records_table(records: list[dict]) -> Table:
 
 # --------------------------------------------------------------------------- rendering
 
-_CSS = """body{font-family:system-ui,sans-serif;max-width:60em;margin:2em auto;padding:0 1em;color:#222}
-table{border-collapse:collapse;margin:0.5em 0}th,td{border:1px solid #ccc;padding:0.2em 0.6em;text-align:left}
+_CSS = """body{font-family:system-ui,sans-serif;max-width:60em;margin:2em auto;padding:0 1em;color:#222;
+overflow-wrap:break-word}
+.wide{max-width:100%;overflow-x:auto}
+table{border-collapse:collapse;margin:0.5em 0;font-size:0.9em}
+th,td{border:1px solid #ccc;padding:0.2em 0.6em;text-align:left;vertical-align:top;
+overflow-wrap:break-word;max-width:28em}th{white-space:nowrap}
 th{background:#f2f2f2}pre{background:#f7f7f7;padding:0.6em;overflow-x:auto}
-figure{margin:1em 0}figcaption{font-style:italic}img{max-width:100%}"""
+details{margin:0.5em 0}summary{cursor:pointer}
+figure{margin:1em 0}figcaption{font-style:italic}img{max-width:100%;height:auto}"""
 
 
 def render_html(report: Report) -> str:
@@ -271,12 +258,15 @@ def render_html(report: Report) -> str:
                 out.append(f"<p>{e(b.text)}</p>")
             elif isinstance(b, Pre):
                 out.append(f"<pre>{e(b.text)}</pre>")
+            elif isinstance(b, Details):
+                out.append(f"<details><summary>{e(b.summary)}</summary><pre>{e(b.text)}</pre>"
+                           "</details>")
             elif isinstance(b, Table):
-                out.append("<table>")
+                out.append('<div class="wide"><table>')
                 out.append("<tr>" + "".join(f"<th>{e(h)}</th>" for h in b.headers) + "</tr>")
                 for row in b.rows:
                     out.append("<tr>" + "".join(f"<td>{e(c)}</td>" for c in row) + "</tr>")
-                out.append("</table>")
+                out.append("</table></div>")
             elif isinstance(b, Image):
                 data = base64.b64encode(b.png).decode("ascii")
                 out.append(f'<figure><img src="data:image/png;base64,{data}" alt="{e(b.title)}">'
@@ -295,22 +285,33 @@ def image_filenames(report: Report) -> list[str]:
 
 
 def _md_cell(text: str) -> str:
-    return text.replace("\\", "\\\\").replace("|", "\\|").replace("\n", " ")
+    return _md_text(text).replace("|", "\\|").replace("\n", " ")
+
+
+def _md_text(text: str) -> str:
+    """User text made literal in Markdown: emphasis, code, link and HTML characters
+    escaped (intraword ``_`` is literal in GitHub Markdown and left readable)."""
+    text = re.sub(r"([\\`*\[\]<>])", r"\\\1", str(text))
+    return text
 
 
 def render_markdown(report: Report, files_dir: str = FILES_DIR) -> tuple[str, dict[str, bytes]]:
     """Markdown text and ``{file name: PNG bytes}`` for the images it links in ``files_dir``."""
     names = iter(image_filenames(report))
     files: dict[str, bytes] = {}
-    out = [f"# {report.title}", ""]
+    out = [f"# {_md_text(report.title)}", ""]
     for section in report.sections:
-        out += [f"## {section.heading}", ""]
+        out += [f"## {_md_text(section.heading)}", ""]
         for b in section.blocks:
             if isinstance(b, Text):
-                out += [b.text, ""]
+                out += [_md_text(b.text), ""]
             elif isinstance(b, Pre):
                 fence = "~~~~" if "```" in b.text else "```"
                 out += [fence, b.text, fence, ""]
+            elif isinstance(b, Details):
+                fence = "~~~~" if "```" in b.text else "```"
+                out += ["<details>", f"<summary>{html.escape(b.summary)}</summary>", "",
+                        fence, b.text, fence, "", "</details>", ""]
             elif isinstance(b, Table):
                 out.append("| " + " | ".join(_md_cell(h) for h in b.headers) + " |")
                 out.append("|" + "---|" * len(b.headers))
@@ -320,7 +321,7 @@ def render_markdown(report: Report, files_dir: str = FILES_DIR) -> tuple[str, di
                 name = next(names)
                 files[name] = b.png
                 alt = b.title.replace("[", "(").replace("]", ")")
-                out += [f"![{alt}]({files_dir}/{name})", "", f"*{b.title}*", ""]
+                out += [f"![{alt}]({files_dir}/{name})", "", f"*{_md_text(b.title)}*", ""]
     return "\n".join(out), files
 
 

@@ -111,7 +111,8 @@ def _is_number(value: Any) -> bool:
 
 
 def metric_vs_param_figures(ds) -> list[tuple[str, Any]]:
-    """For each metric and each swept numeric parameter: metric against parameter.
+    """For each metric that varies and each swept numeric parameter: metric against
+    parameter (not a metric that repeats the parameter, not constants, not timings).
 
     The other swept parameters split the points into one line each (legend ``k=v, ...``).
     Axes are log-log when every plotted value is positive, linear otherwise.
@@ -124,9 +125,14 @@ def metric_vs_param_figures(ds) -> list[tuple[str, Any]]:
     numeric = [p for p in params if all(_is_number(r.get(p)) for r in records)]
     figures = []
     for metric in sweep_metrics(ds):
+        ys = [r.get(metric) for r in records if _is_number(r.get(metric))]
+        if len({y for y in ys if not math.isnan(y)}) < 2 or metric.startswith("time_"):
+            continue  # a constant says nothing against the sweep; timings have their own table
         attrs = ds[metric].attrs
         ylabel = _axis_label(metric, attrs)
         for param in numeric:
+            if [r.get(param) for r in records] == [r.get(metric) for r in records]:
+                continue  # the swept value itself (n_points against source_n_points)
             others = [p for p in params if p != param]
             lines: dict[tuple, list[tuple[float, float]]] = {}
             for r in records:

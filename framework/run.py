@@ -13,6 +13,7 @@ import numpy as np
 
 from .context import RunContext
 from .errors import PointatlasError
+from .headline import declare_headline
 from .provenance import command_line, git_commit, hostname, now_iso, source_attr
 from .registry import FAMILIES
 from .results import (check_variables, metric_names, metric_values, write_results,
@@ -97,6 +98,7 @@ def run_study(*, config: dict, choices: dict[str, str], overrides: list[str], ru
         for label, seconds in sorted(ctx.timings.items()):
             ds[f"time_{label}"] = ((), seconds, {"long_name": f"wall time of {label}", "units": "s"})
         references = getattr(type(study), "references", {}) or {}
+        headline = declare_headline(ds, type(study), config)
         attrs = {
             "Conventions": "CF-1.10",
             "title": config.get("title") or ds.attrs.get("title") or f"pointatlas {experiment}",
@@ -117,6 +119,7 @@ def run_study(*, config: dict, choices: dict[str, str], overrides: list[str], ru
             "study": plugins["study"],
             "plugins": plugins,
             "metrics": metric_names(ds),
+            "headline": headline,
             "references": references,
         }
         metrics = metric_values(ds)

@@ -158,13 +158,14 @@ def test_sweep_report_generic_figures(tmp_path, fake_loader):
     assert [r["source.n_points"] for r in records] == [100, 200, 400]
     assert records[2]["max_error"] == pytest.approx(1 / 400)
     figs = metric_vs_param_figures(ds)
-    assert [t for t, _ in figs] == ["max_error vs source.n_points", "fit_time vs source.n_points"]
+    # fit_time is the same in every run: a constant is not plotted against the sweep
+    assert [t for t, _ in figs] == ["max_error vs source.n_points"]
     assert figs[0][1].axes[0].get_xscale() == "log" and figs[0][1].axes[0].get_yscale() == "log"
     report = build_sweep_report(ds, tmp_path)
     paths = write_report(report, tmp_path)
     html_text = paths[0].read_text()
     assert "max_error vs source.n_points" in html_text and "3 runs" in html_text
-    assert html_text.count("data:image/png;base64,") == 2
+    assert html_text.count("data:image/png;base64,") == 1
     assert "0.0025" in html_text  # 1/400 in the runs table
     assert fake_loader.calls == []  # FakeSource has no report_sweep_figures
 
@@ -193,9 +194,10 @@ def test_cli_sweep_2d_grid(tmp_path, fake_loader):
         make_run(n, error=k / n, extra_overrides=[f"embedder.k={k}"]).to_netcdf(tmp_path / str(job) / "results.nc")
     assert main([str(tmp_path), "--format", "md"]) == 0
     md_text = (tmp_path / "report.md").read_text()
-    assert "4 runs" in md_text and "| embedder.k | source.n_points |" in md_text
-    # 2 metrics x 2 numeric params
-    assert len(re.findall(r"!\[max_error vs|!\[fit_time vs", md_text)) == 4
+    assert "4 runs" in md_text and "| embedder_k | source_n_points |" in md_text
+    # the metric that varies against the 2 numeric params (fit_time is constant)
+    assert len(re.findall(r"!\[max_error vs", md_text)) == 2
+    assert "fit_time vs" not in md_text
     assert "| 8 | 200 | 0.04 |" in md_text
 
 

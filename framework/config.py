@@ -51,6 +51,14 @@ class Tracking(enum.StrEnum):
     mlflow = "mlflow"
 
 
+class UnitsSystem(enum.StrEnum):
+    """Values of the top-level key ``units_system`` (:mod:`pointatlas.units`)."""
+
+    SI = "SI"
+    mm_N_s = "mm_N_s"
+    nondimensional = "nondimensional"
+
+
 @dataclass
 class RunConfig:
     """Top-level keys of every run (the plugin groups are filled by the defaults list)."""
@@ -72,6 +80,9 @@ class RunConfig:
     title: str = ""
     #: experiment-specific settings (reference values, lists of embedders...)
     extra: dict = dataclasses.field(default_factory=dict)
+    #: units of the results of problems posed in consistent units (a shell's lengths, forces):
+    #: SI (m, N, J), mm_N_s (mm, N, mJ) or nondimensional (pointatlas.units)
+    units_system: UnitsSystem = UnitsSystem.SI
     #: mirror the run into an experiment tracker: none, or mlflow (pointatlas.mlflow_tracking)
     tracking: Tracking = Tracking.none
     #: the MLflow store ('' = $MLFLOW_TRACKING_URI, else ./mlruns); e.g. file:/abs/mlruns

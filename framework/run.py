@@ -23,6 +23,7 @@ from .liveness import identity
 from .mlflow_tracking import mirror_run
 from .run_filters import flatten_settings
 from .run_record import RunRecorder
+from .units import convert_units
 
 log = logging.getLogger("pointatlas.run")
 PLUGIN_FAMILIES = tuple(FAMILIES.values())
@@ -122,6 +123,7 @@ def run_study(*, config: dict, choices: dict[str, str], overrides: list[str], ru
             "headline": headline,
             "references": references,
         }
+        convert_units(ds, str(config.get("units_system") or "SI"))
         metrics = metric_values(ds)
         path = write_results(ds, run_dir / RESULTS_NAME, attrs)
     except BaseException as exc:

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from .errors import ConfigError
-from .progress import Progress
+from .progress import Heartbeat, Progress
 from .registry import load_plugin
 
 
@@ -93,8 +93,9 @@ class RunContext:
         return Progress(iterable, total=total, desc=desc, logger=self.log)
 
     def timed(self, label: str):
-        """Context manager adding the wall time of a block to ``timings[label]`` (s)."""
-        return _Timer(self.timings, label)
+        """Context manager adding the wall time of a block to ``timings[label]`` (s); a block
+        that runs longer than 10 s logs that it is still running every 10 s."""
+        return _Timer(self.timings, label, self.log)
 
 
 class _RecordedSource:
@@ -122,17 +123,20 @@ def _constructible(config: type) -> bool:
 
 
 class _Timer:
-    def __init__(self, store: dict, label: str):
+    def __init__(self, store: dict, label: str, logger=None):
         self.store, self.label = store, label
+        self.heartbeat = Heartbeat(label, logger)
 
     def __enter__(self):
         import time
 
         self.t0 = time.perf_counter()
+        self.heartbeat.__enter__()
         return self
 
     def __exit__(self, *exc):
         import time
 
+        self.heartbeat.__exit__(*exc)
         self.store[self.label] = self.store.get(self.label, 0.0) + time.perf_counter() - self.t0
         return False

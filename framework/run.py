@@ -14,6 +14,7 @@ import numpy as np
 from .context import RunContext
 from .errors import PointatlasError
 from .headline import declare_headline
+from .jit_time import compile_seconds
 from .provenance import command_line, git_commit, hostname, now_iso, source_attr
 from .registry import FAMILIES
 from .results import (check_variables, metric_names, metric_values, write_results,
@@ -81,6 +82,7 @@ def run_study(*, config: dict, choices: dict[str, str], overrides: list[str], ru
         **identity()}, indent=1) + "\n")
     tracked = dict(run_id=run_id, run_dir=run_dir, experiment=experiment, choices=choices,
                    overrides=list(overrides), start_time=start)
+    compile0 = compile_seconds()
     t0 = time.perf_counter()
     if config.get("quiet"):
         logging.getLogger("pointatlas").setLevel(logging.WARNING)
@@ -97,7 +99,11 @@ def run_study(*, config: dict, choices: dict[str, str], overrides: list[str], ru
                 ds[f"source_{key}"] = ((), value, {"long_name": f"source: {key.replace('_', ' ')}",
                                                    "units": "1"})
         for label, seconds in sorted(ctx.timings.items()):
-            ds[f"time_{label}"] = ((), seconds, {"long_name": f"wall time of {label}", "units": "s"})
+            ds[f"time_{label}"] = ((), seconds, {
+                "long_name": f"wall time of {label} (numba compilation excluded)", "units": "s"})
+        ds["time_jit_compile"] = ((), compile_seconds() - compile0, {
+            "long_name": "wall time of numba compilation (and cache loads) in the run",
+            "units": "s"})
         references = getattr(type(study), "references", {}) or {}
         headline = declare_headline(ds, type(study), config)
         attrs = {

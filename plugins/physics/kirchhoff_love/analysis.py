@@ -9,8 +9,6 @@ the membrane and bending strain–displacement matrices (Paper 1 App. C); (4) no
 """
 from __future__ import annotations
 
-import time
-from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -37,11 +35,11 @@ class ShellModel(SurfaceModel):
         return 3 * self.nodes.shape[0]
 
 
-@contextmanager
 def _timed(times: dict, key: str):
-    t0 = time.perf_counter()
-    yield
-    times[key] = times.get(key, 0.0) + time.perf_counter() - t0
+    """Wall time of a stage less numba's compilation in it (pointatlas.jit_time)."""
+    from pointatlas.jit_time import StageTimer
+
+    return StageTimer(times, key)
 
 
 def build_model(cloud, settings, atlas_settings, make_embedder, make_lme, make_pu,

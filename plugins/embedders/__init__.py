@@ -5,5 +5,6 @@ Shared pieces: ``neighbor_graph`` (k-NN / radius graphs, connectivity), ``geodes
 shortest paths), ``mds`` (classical and landmark MDS), ``aic`` (affine isometric correction,
 thesis Appendix E.1), ``quality`` (stress E_S, trustworthiness, residual variance,
 reconstruction error), ``intrinsic_dimension`` (thesis §2.3), ``nlie_stress`` / ``newton_cg``
-(NLIE energy, derivatives and optimiser, thesis Appendix C).
+(NLIE energy, derivatives and optimiser, thesis Appendix C), ``out_of_sample`` (the extensions
+behind ``transform``). Every embedder is a scikit-learn transformer (``base.EmbedderBase``).
 """

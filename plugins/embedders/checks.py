@@ -33,6 +33,25 @@ def check_points(X, *, min_points: int = 2, what: str = "points", reason: str = 
     return X
 
 
+def check_components(n_components: int, X: np.ndarray, *, method: str = "the embedding") -> int:
+    """``n_components`` d is below the number of features D (an embedding reduces the
+    dimension) and below the number of points N (N centred points span at most N - 1
+    dimensions); returns d."""
+    d = int(n_components)
+    n, D = X.shape
+    if d >= D:
+        fix = (f"Lower n_components to at most {D - 1}" if D > 1
+               else "Give points with two or more coordinates")
+        raise ConfigError(
+            f"n_components={d} must be below the ambient dimension: the points have {D} "
+            f"feature(s) (coordinates), so {method} cannot reduce their dimension. {fix}.")
+    if d >= n:
+        raise ConfigError(f"n_components={d} must be below the number of points ({n} "
+                          f"sample(s)); lower n_components to at most {n - 1} or give more "
+                          "points.")
+    return d
+
+
 def check_one_graph(n_neighbors, radius) -> None:
     """Exactly one of ``n_neighbors`` / ``radius`` defines the neighbour graph (each value's
     own range: the declared :data:`GRAPH` constraints)."""

@@ -1,4 +1,7 @@
-"""Modified locally linear embedding (Zhang & Wang 2007; thesis §2.2), via scikit-learn."""
+"""Modified locally linear embedding (Zhang & Wang 2007; thesis §2.2), via scikit-learn.
+
+``transform`` is LLE's barycentric extension (:mod:`.lle`, :func:`.out_of_sample.lle_extension`).
+"""
 from __future__ import annotations
 
 from dataclasses import dataclass

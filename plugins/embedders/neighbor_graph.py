@@ -1,7 +1,8 @@
 """Neighbour graphs on point sets (k nearest neighbours or fixed radius) and their connectivity.
 
 Isomap, NLIE, AIC and the stress measure all approximate geodesic distances by shortest paths
-in this graph (thesis §2.2, "Isomap"; Appendix C).
+in this graph (thesis §2.2, "Isomap"; Appendix C). :func:`attach_points` appends new points to a
+training graph, for the out-of-sample extensions (``transform``) of Isomap and NLIE.
 """
 from __future__ import annotations
 
@@ -61,3 +62,42 @@ def connected_neighbor_graph(X: np.ndarray, n_neighbors: int | None = 12,
     param = f"n_neighbors (now {n_neighbors})" if n_neighbors is not None else f"radius (now {radius:g})"
     check_connected(G, what=describe_graph(n_neighbors, radius), fix=f"increase {param}")
     return G
+
+
+def attach_points(G: sp.csr_matrix, tree, X_new: np.ndarray, n_neighbors: int | None = 12,
+                  radius: float | None = None) -> sp.csr_matrix:
+    """The training graph ``G`` (N, N) with M new points appended as nodes N..N+M-1.
+
+    New point x gets one-way edges x -> x_b to its ``n_neighbors`` nearest training points
+    (or to those within ``radius``), of length |x - x_b|; no edge enters a new node, so a
+    shortest path from x leaves it once and then runs in the training graph:
+    delta(x, x_j) = min_b (|x - x_b| + delta_G(x_b, x_j)), the out-of-sample geodesic distance of
+    Isomap (Bengio et al. 2004, "Out-of-sample extensions for LLE, Isomap, MDS, Eigenmaps and
+    spectral clustering", §4). ``tree`` is a ``scipy.spatial.cKDTree`` of the training points.
+    A point that coincides with x_b gets an edge of length 0 (kept as an explicit zero).
+    Returns an (N + M, N + M) CSR matrix.
+    """
+    G = sp.csr_matrix(G)
+    n, m = G.shape[0], X_new.shape[0]
+    if n_neighbors is not None:
+        k = min(int(n_neighbors), n)
+        dist, idx = tree.query(X_new, k=k)
+        dist, idx = dist.reshape(m, k), idx.reshape(m, k)
+        counts = np.full(m, k)
+        idx, dist = idx.ravel(), dist.ravel()
+    else:
+        lists = tree.query_ball_point(X_new, r=radius)
+        counts = np.array([len(c) for c in lists])
+        if (counts == 0).any():
+            far = np.flatnonzero(counts == 0)
+            raise InputError(
+                f"{far.size} new point(s) (first: rows {far[:5].tolist()}) lie farther than "
+                f"radius={radius:g} from every training point, so the radius graph cannot reach "
+                "them. Transform points near the training set, or refit with a larger radius.")
+        idx = np.concatenate([np.asarray(c, np.int64) for c in lists])
+        rows = np.repeat(np.arange(m), counts)
+        dist = np.linalg.norm(X_new[rows] - tree.data[idx], axis=1)
+    indptr = np.concatenate([G.indptr, G.indptr[-1] + np.cumsum(counts)]).astype(np.int64)
+    indices = np.concatenate([G.indices, idx]).astype(np.int64)
+    data = np.concatenate([G.data, dist]).astype(np.float64)
+    return sp.csr_matrix((data, indices, indptr), shape=(n + m, n + m))

@@ -15,6 +15,13 @@ constant in N. Memory and time per iteration are linear in N k_G.
 Convergence: max_i |dE_S/dq_i| <= tol * kbar / median(g) (``gradient_tolerance``), kbar the mean
 number of pairs per point: the largest force on a point is at most that of all its pairs being
 off by a relative length error ``tol`` in the same direction. Dimensionless, the same for all N.
+
+Out of sample (``transform``, :func:`.out_of_sample.stress_placement`): a new point x joins the
+training graph by one-way edges to its graph neighbours (``neighbor_graph.attach_points``); its
+k_G geodesically nearest training points and distances g_j give the NLIE stress of its pairs,
+minimised over y alone with the training embedding fixed, from the barycentric (LLE-weight)
+combination of its nearest neighbours' coordinates. A training point is placed on its own
+embedding, the limit of that minimiser (g_i -> 0), so ``transform`` reproduces it exactly.
 """
 from __future__ import annotations
 
@@ -27,13 +34,15 @@ from pointatlas.constraints import Interval
 from pointatlas.errors import ConfigError
 
 from .base import EmbedderBase
-from .checks import AIC, COMPONENTS, GRAPH, check_graph_fits, check_one_graph, check_points
+from .checks import (AIC, COMPONENTS, GRAPH, check_components, check_graph_fits, check_one_graph,
+                     check_points)
 from .geodesics import geodesic_neighbors, pairs_from_neighbors
 from .isomap import landmark_isomap_embedding
-from .neighbor_graph import connected_neighbor_graph
+from .neighbor_graph import attach_points, connected_neighbor_graph
 from .newton_cg import newton_line_search
 from .nlie_stress import (NearPairPreconditioner, hessian_diagonal_blocks, hessian_matvec,
                           near_pairs, pair_curvatures, stress_energy, stress_energy_grad)
+from .out_of_sample import barycentric_weights, stress_placement
 from .quality import stress_on_pairs
 
 
@@ -215,12 +224,12 @@ class NLIE(EmbedderBase):
                 "seed_landmarks=1000.")
 
     def _embed(self, X) -> np.ndarray:
+        from scipy.spatial import cKDTree
+
+        d = check_components(self.n_components, X, method="NLIE")
         X = check_points(X, min_points=2)
         n = X.shape[0]
         check_graph_fits(self.n_neighbors, n)
-        d = int(self.n_components)
-        if d >= X.shape[1]:
-            raise ConfigError(f"n_components={d} must be below the ambient dimension {X.shape[1]}.")
         kG = int(self.n_stress_neighbors)
         if kG > n - 1:
             raise ConfigError(
@@ -246,4 +255,18 @@ class NLIE(EmbedderBase):
         self.info_ = info
         nb = nb if nb is not None else geodesic_neighbors(G, k)
         self.stress_ = stress_on_pairs(Y, *nb)   # E_S as in Table 1 (k = aic_neighbors)
+        self.graph_ = G
+        self.tree_ = cKDTree(X)
         return Y
+
+    def _extend(self, X: np.ndarray) -> np.ndarray:
+        """Stress placement of new points (module docstring), from ``embedding_raw_``."""
+        n, m = self.graph_.shape[0], X.shape[0]
+        G = attach_points(self.graph_, self.tree_, X, self.n_neighbors, self.radius)
+        idx, g = geodesic_neighbors(G, int(self.n_stress_neighbors), sources=n + np.arange(m))
+        Y = self.embedding_raw_
+        k0 = min(idx.shape[1], int(self.n_neighbors or 12))   # start: LLE weights (reg 1e-3)
+        w = barycentric_weights(self.tree_.data[idx[:, :k0]] - X[:, None, :], 1e-3)
+        y0 = np.einsum("mk,mkd->md", w, Y[idx[:, :k0]])
+        return stress_placement(Y, idx, g, float(self.alpha), y0, tol=float(self.tol),
+                                max_iter=int(self.max_iter))

@@ -1,4 +1,8 @@
-"""PCA embedder: projection onto the d leading principal directions (thesis §2.1)."""
+"""PCA embedder: projection onto the d leading principal directions (thesis §2.1).
+
+y = W^T (x - mean), W (D, d) the leading right singular vectors of the centred points; the
+same formula maps new points (``transform``), so it reproduces the training embedding exactly.
+"""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -6,10 +10,8 @@ from typing import ClassVar, Optional
 
 import numpy as np
 
-from pointatlas.errors import ConfigError
-
 from .base import EmbedderBase
-from .checks import AIC, COMPONENTS, check_points
+from .checks import AIC, COMPONENTS, check_components, check_points
 
 
 @dataclass
@@ -36,15 +38,14 @@ class PCA(EmbedderBase):
     def _embed(self, X) -> np.ndarray:
         from sklearn.decomposition import PCA as _PCA
 
+        d = check_components(self.n_components, X, method="PCA")
         X = check_points(X, min_points=2)
-        d = int(self.n_components)
-        if d >= X.shape[1]:
-            raise ConfigError(
-                f"n_components={d} but the points live in R^{X.shape[1]}: PCA needs "
-                f"n_components < {X.shape[1]} to reduce the dimension. Lower n_components."
-            )
         model = _PCA(n_components=d, svd_solver="full").fit(X)
         self.components_ = model.components_
         self.explained_variance_ratio_ = model.explained_variance_ratio_
         self.mean_ = model.mean_
-        return model.transform(X)
+        return self._extend(X)
+
+    def _extend(self, X: np.ndarray) -> np.ndarray:
+        """The linear projection y = W^T (x - mean) (``components_`` = W^T, ``mean_``)."""
+        return (X - self.mean_) @ self.components_.T

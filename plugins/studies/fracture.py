@@ -27,7 +27,9 @@ displacement) by the trapezoidal rule, plus the work of dead loads t Fᵀu),
 ``away_from_precracks``: outside the pre-cracks' own bands at increment 0, as the physics
 defines them, ``problem.away_from_precracks``; every point without pre-crack), and
 the fields ``phase_field`` and ``displacement`` at every sampled point; the run directory
-gets ``snapshots/increment_NNNN.vtp`` (υ, u and the deformed points) of every increment.
+gets ``snapshots/increment_NNNN.vtp`` (the surface's triangles, υ, u and the deformed points,
+with units; :mod:`pointatlas_kit.paraview`) of every increment and ``fracture.pvd``, the
+series ParaView animates (timestep = t).
 
 With ``griffith_half_length`` a and ``griffith_width`` W (a plate of width W with a central
 crack 2a pulled normal to it; ``griffith_model: quarter`` for the quarter x, y ≥ 0 with
@@ -179,7 +181,7 @@ class FractureStudy:
             ctx, problem, records, step,
             lambda recs, st: store.write(path, problem, recs, st, settings))
         ds = store.dataset(problem, records)
-        self._snapshots(ctx.run_dir / "snapshots", problem, records)
+        self._snapshots(ctx, problem, records)
         ds.attrs["title"] = f"phase-field fracture of {cloud.name}"
         ds.attrs["stopped"] = stopped or "completed the path"
         warnings = [f"the path stopped before study.max_factor: {stopped}"] if stopped else []
@@ -286,12 +288,19 @@ class FractureStudy:
         return fracture_figures(ds)
 
     @staticmethod
-    def _snapshots(folder, problem, records):
-        """``snapshots/increment_NNNN.vtp`` of every increment (υ, u, deformed shape), written
-        from the records at the end, so a resumed run has them all too."""
-        folder.mkdir(parents=True, exist_ok=True)
+    def _snapshots(ctx, problem, records):
+        """``snapshots/increment_NNNN.vtp`` of every increment (surface triangles, υ, u, the
+        deformed shape) and ``fracture.pvd`` listing them with timestep = the factor t
+        (ParaView animates the path), written from the records at the end, so a resumed run
+        has them all too and the .pvd lists exactly the increments of the results."""
+        from pointatlas_kit.paraview import Array, SnapshotSeries, units_system_of
+
+        series = SnapshotSeries(ctx.run_dir / "fracture.pvd", ctx.run_dir / "snapshots")
         for k, r in enumerate(records):
-            problem.write_vtp(r, folder / f"increment_{k:04d}.vtp")
+            problem.write_vtp(r, series.path(k), field_data={
+                "TimeValue": Array(float(r.factor), "1", "the factor t (the .pvd's timestep)")},
+                units_system=units_system_of(ctx))
+        series.publish([float(r.factor) for r in records])
 
     def _griffith(self, ds, material):
         """peak_stress, griffith_stress and relative_error (module doc)."""

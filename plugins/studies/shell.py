@@ -4,7 +4,10 @@ The source gives the points of the shell's middle surface; the ``kirchhoff_love`
 plugin builds the atlas (with ghost nodes beyond the boundary), applies the supports and
 loads of its config and solves. The study reads the displacement at ``reference_point``
 along ``reference_direction`` (the sign convention of the published value), compares it with
-``references`` and writes the deformed shape to ``shell.vtp`` for ParaView.
+``references`` and writes ``shell.vtp`` for ParaView (``write_vtp``): the surface's triangles
+with ``u``, ``u_magnitude``, ``deformed`` (x + magnification·u) and ``on_boundary``, each
+array's units in the field data (:mod:`pointatlas_kit.paraview`); Warp By Vector with ``u``
+at the field value ``magnification`` draws the deformed shape of the report's picture.
 Obstacle course references: BENCHMARKS.md (plate L1337, Scordelis–Lo and hemisphere L1343,
 cylinder L1427 of the thesis).
 """
@@ -117,7 +120,9 @@ class ShellStudy:
         ds.attrs["magnification"] = mag
         ds.attrs["title"] = f"Kirchhoff–Love shell: {cloud.name}, {int(ds['dof'])} DOF"
         if self.write_vtp:
-            physics.export_vtp(ctx.run_dir / "shell.vtp", mag)
+            from pointatlas_kit.paraview import units_system_of
+
+            physics.export_vtp(ctx.run_dir / "shell.vtp", mag, units_system_of(ctx))
         return ds
 
     @staticmethod

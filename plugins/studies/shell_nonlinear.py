@@ -26,6 +26,15 @@ settings) continues the path exactly where it stopped, and its results hold ever
 the earlier ones included, as an uninterrupted run's would. Published curves
 (``reference_load_factors`` × ``reference_values``, one row per monitored point) give
 ``max_relative_error``.
+
+With ``write_vtp`` (default) every converged increment k is also written for ParaView as
+``snapshots/increment_NNNN.vtp`` (surface triangles, ``u``, ``u_magnitude``,
+``energy_density``, ``bending_fraction``, with units; :mod:`pointatlas_kit.paraview`), and
+``shell_nonlinear.pvd`` is rewritten to list increments 0…k (timestep λ; the increment index
+under arc length): after a kill it lists exactly the increments whose files are complete,
+and a resumed run writes those of ``resume_from`` first, so its files are the uninterrupted
+run's. Warp By Vector with ``u`` draws the deformed shape (scale ``study.magnification``, 1
+when 0).
 """
 from __future__ import annotations
 
@@ -166,6 +175,7 @@ class ShellNonlinearStudy:
                             levels=tuple(self.reference_load_factors))
         self._imposed = model.imposed
         self._has_loads = model.has_loads
+        series = self._series(ctx, physics, model, records)
 
         def keep(inc):
             records.append(inc)
@@ -175,6 +185,8 @@ class ShellNonlinearStudy:
                          inc.load_factor, inc.iterations, "stable" if inc.stable else "UNSTABLE",
                          ", ".join(f"{n} = {v:.5g}" for n, v in zip(names, values[-1])))
             self._write(ctx.run_dir / "increments.nc", model, records, values, names, settings)
+            if series is not None:
+                self._snapshot(series, records, len(records) - 1)
 
         from pointatlas_solvers.increment import PathFollowingError
 
@@ -256,6 +268,50 @@ class ShellNonlinearStudy:
         pairs = [self._load(r.load_factor, r.reactions) for r in records]
         return path_dataset(self, model.n_dofs, self._points, records, values, names,
                             self._fields, pairs)
+
+    def _series(self, ctx, physics, model, records):
+        """With ``write_vtp``: the ParaView series (``snapshots/increment_NNNN.vtp`` and
+        ``shell_nonlinear.pvd``, :class:`pointatlas_kit.paraview.SnapshotSeries`) with the
+        increments of ``records`` already written (those of ``resume_from``: a resumed run
+        has the files of the uninterrupted one); None without."""
+        if not self.write_vtp:
+            return None
+        from pointatlas_kit.paraview import SnapshotSeries, units_system_of
+
+        series = SnapshotSeries(ctx.run_dir / "shell_nonlinear.pvd", ctx.run_dir / "snapshots")
+        self._units_system = units_system_of(ctx)
+        self._triangles = physics.surface_triangles(model)
+        for k in range(len(records)):
+            self._snapshot(series, records, k, publish=k == len(records) - 1)
+        return series
+
+    def _snapshot(self, series, records, k: int, publish: bool = True) -> None:
+        """Increment ``k``'s .vtp (surface triangles; ``u``, ``u_magnitude``,
+        ``energy_density``, ``bending_fraction`` with units; field values ``load_factor``,
+        ``load``, ``magnification``), then the .pvd listing increments 0…k, timestep = the
+        load factor λ (the increment index under arc length, where λ may go back)."""
+        from pointatlas_kit.paraview import Array, write_vtp
+
+        u, w = self._fields[k]
+        r = records[k]
+        load, what = self._load(r.load_factor, r.reactions)
+        total = w[:, 2]
+        write_vtp(series.path(k), self._points, self._triangles, {
+            "u": Array(u, "length", "displacement u(x_a) at the sampled points"),
+            "u_magnitude": Array(np.linalg.norm(u, axis=1), "length", "|u|"),
+            "energy_density": Array(total, "energy/length²", "strain energy per unit "
+                                    "reference area (membrane + bending)"),
+            "bending_fraction": Array(w[:, 1] / np.where(total > 0, total, 1.0), "1",
+                                      "bending share of the energy density")}, {
+            "load_factor": Array(float(r.load_factor), "1", "load factor λ"),
+            "load": Array(float(load), "force", what),
+            "magnification": Array(float(self.magnification or 1.0), "1",
+                                   "scale factor of u for Warp By Vector")},
+            self._units_system)
+        if publish:
+            lam = [float(x.load_factor) for x in records[:k + 1]]
+            by_lambda = self.control != "arc_length" and bool(np.all(np.diff(lam) > 0))
+            series.publish(lam if by_lambda else list(range(k + 1)))
 
     def _write(self, path: Path, model, records, values, names, settings):
         """increments.nc with all converged increments and the path state (durably)."""

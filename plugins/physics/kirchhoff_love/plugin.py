@@ -116,11 +116,21 @@ class KirchhoffLove:
             raise ConfigError(f"kirchhoff_love has the field 'displacement', not {name!r}.")
         return values_at(model.atlas, model.nodal_displacement, x)
 
-    def export_vtp(self, path, magnification: float = 1.0):
-        """The solved shell as a ParaView .vtp file (points, u, |u|, the deformed shape)."""
+    def export_vtp(self, path, magnification: float = 1.0, units_system: str = "SI"):
+        """The solved shell as a ParaView .vtp file: surface triangles, ``u``, |u|, the
+        deformed shape, each array's units in ``units_system`` (:func:`.results.write_vtp`)."""
         from .results import write_vtp
 
-        return write_vtp(self._solved(), path, magnification)
+        return write_vtp(self._solved(), path, magnification, units_system)
+
+    def surface_triangles(self, problem=None):
+        """(T, 3) indices into the sampled points: the triangles of the surface of the built
+        path ``problem`` (from :meth:`path_problem`), or of the solved shell without one
+        (:func:`pointatlas_kit.surface_mesh.surface_triangles`), for ParaView files."""
+        from pointatlas_kit.surface_mesh import surface_triangles
+
+        model = self._solved() if problem is None else problem.model
+        return surface_triangles(model.atlas, model.points.shape[0])
 
     def path_problem(self, ctx, *, cloud, atlas_settings):
         """A :class:`.path_problem.ShellPath` (equilibrium problem, monitors, point fields)."""

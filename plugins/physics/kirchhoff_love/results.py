@@ -1,7 +1,6 @@
 """A solved shell as an xarray Dataset (dims point, dim) and as a ParaView ``.vtp`` file."""
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import numpy as np
@@ -51,18 +50,31 @@ def field_dataset(model):
         "dim": ("dim", ["x", "y", "z"], {"long_name": "Cartesian component", "units": "1"})})
 
 
-def write_vtp(model, path: Path, magnification: float = 1.0) -> Path:
-    """The sampled points with their displacement (and the deformed position, magnified) as a
-    PolyData ``.vtp`` (written to a temporary name, then renamed)."""
-    import pyvista as pv
+def write_vtp(model, path: Path, magnification: float = 1.0, units_system: str = "SI") -> Path:
+    """The solved shell as a ParaView ``.vtp`` (:mod:`pointatlas_kit.paraview`, written
+    atomically): the sampled points x_a (reference configuration) with the triangles of the
+    surface from the atlas's charts (:mod:`pointatlas_kit.surface_mesh`), point arrays ``u``
+    (displacement, length), ``u_magnitude`` |u| (length), ``deformed`` x_a + magnification·u
+    (length) and ``on_boundary`` (1), each with its ``NAME_units`` (in ``units_system``, as
+    the run's results.nc) and ``NAME_quantity`` in the field data, and the field value
+    ``magnification`` (1): Warp By Vector with ``u`` at this scale factor draws the deformed
+    shape that ``deformed`` holds."""
+    from pointatlas_kit.paraview import Array, write_vtp as write
+    from pointatlas_kit.surface_mesh import surface_triangles
 
-    path = Path(path)
-    cloud = pv.PolyData(np.ascontiguousarray(model.points))
-    cloud.point_data["displacement"] = np.ascontiguousarray(model.displacement)
-    cloud.point_data["displacement_magnitude"] = np.linalg.norm(model.displacement, axis=1)
-    cloud.point_data["deformed"] = model.points + magnification * model.displacement
-    cloud.point_data["on_boundary"] = model.boundary.astype(np.int8)
-    tmp = path.with_name(path.stem + ".partial.vtp")
-    cloud.save(str(tmp))
-    os.replace(tmp, path)
-    return path
+    m = float(magnification)
+    if not np.isfinite(m):
+        from pointatlas.errors import InputError
+
+        raise InputError(f"magnification = {magnification!r}: give a finite number.")
+    u = np.asarray(model.displacement, dtype=np.float64)
+    x = np.asarray(model.points, dtype=np.float64)
+    triangles = surface_triangles(model.atlas, x.shape[0])
+    return write(path, x, triangles, {
+        "u": Array(u, LENGTH, "displacement u(x_a) at the sampled points"),
+        "u_magnitude": Array(np.linalg.norm(u, axis=1), LENGTH, "|u|"),
+        "deformed": Array(x + m * u, LENGTH, f"deformed position x_a + {m:g}·u"),
+        "on_boundary": Array(model.boundary.astype(np.int8), "1",
+                             "1 if the point was detected on the boundary")},
+        {"magnification": Array(m, "1", "scale factor of u in 'deformed' (Warp By Vector)")},
+        units_system)

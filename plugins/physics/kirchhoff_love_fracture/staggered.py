@@ -353,25 +353,31 @@ class StaggeredProblem:
                              int(iterations), dict(energy), reactions, [], int(negative_modes),
                             int(monolithic_iterations))
 
-    def write_vtp(self, state: FractureState, path, magnification: float = 1.0):
-        """The sampled points of ``state`` as a ParaView ``.vtp``: ``phase_field`` υ,
-        ``displacement`` u and ``deformed`` = x + magnification·u (temporary name, then
-        renamed)."""
-        import os
-        from pathlib import Path
+    def write_vtp(self, state: FractureState, path, magnification: float = 1.0,
+                  field_data=None, units_system: str = "SI"):
+        """The sampled points of ``state`` as a ParaView ``.vtp`` (:mod:`pointatlas_kit.
+        paraview`, written atomically): the surface triangles (from the atlas's charts,
+        computed once), point arrays ``phase_field`` υ (1), ``u`` (length), ``u_magnitude``
+        |u| (length) and ``deformed`` = x + magnification·u (length), each with its
+        ``NAME_units`` (in ``units_system``); field values ``load_factor`` t (1),
+        ``magnification`` (1) and ``field_data`` (name → :class:`pointatlas_kit.paraview.
+        Array`, e.g. ``TimeValue``)."""
+        from pointatlas_kit.paraview import Array, write_vtp
+        from pointatlas_kit.surface_mesh import surface_triangles
 
-        import pyvista as pv
-
+        if getattr(self, "_surface_triangles", None) is None:
+            self._surface_triangles = surface_triangles(self.model.atlas,
+                                                        self.model.points.shape[0])
         v, u = self.point_fields(state)
-        path = Path(path)
-        cloud = pv.PolyData(np.ascontiguousarray(self.model.points))
-        cloud.point_data["phase_field"] = np.ascontiguousarray(v)
-        cloud.point_data["displacement"] = np.ascontiguousarray(u)
-        cloud.point_data["deformed"] = self.model.points + magnification * u
-        tmp = path.with_name(path.stem + ".partial.vtp")
-        cloud.save(str(tmp))
-        os.replace(tmp, path)
-        return path
+        x, m = self.model.points, float(magnification)
+        return write_vtp(path, x, self._surface_triangles, {
+            "phase_field": Array(v, "1", "phase field υ (1: intact, 0: broken)"),
+            "u": Array(u, "length", "displacement u(x_a) at the sampled points"),
+            "u_magnitude": Array(np.linalg.norm(u, axis=1), "length", "|u|"),
+            "deformed": Array(x + m * u, "length", f"deformed position x_a + {m:g}·u")},
+            {"load_factor": Array(float(state.factor), "1", "imposed-displacement factor t"),
+             "magnification": Array(m, "1", "scale factor of u in 'deformed'"),
+             **(field_data or {})}, units_system)
 
     def reaction(self, state: FractureState) -> float:
         """Σ over the imposed-displacement supports of their resultant force along the

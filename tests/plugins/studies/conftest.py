@@ -55,3 +55,36 @@ def interrupt_fracture(monkeypatch):
             monkeypatch.setattr(store, "write", real)
 
     return interrupt
+
+
+@pytest.fixture(scope="session")
+def paraview_series():
+    """read(pvd): the steps of a ParaView collection as [(timestep, pyvista mesh)], after
+    checking what ParaView needs: a Collection whose files exist (relative to the .pvd),
+    named increment_0000, 0001, … in order, timesteps increasing strictly and those pyvista's
+    PVD reader reports; every step a triangulated surface over all its points."""
+    import xml.etree.ElementTree as ET
+    from pathlib import Path
+
+    import numpy as np
+    import pyvista as pv
+
+    def read(pvd):
+        pvd = Path(pvd)
+        root = ET.parse(pvd).getroot()
+        assert root.tag == "VTKFile" and root.get("type") == "Collection"
+        steps = root.find("Collection").findall("DataSet")
+        files = [s.get("file") for s in steps]
+        assert files == [f"snapshots/increment_{k:04d}.vtp" for k in range(len(steps))]
+        times = [float(s.get("timestep")) for s in steps]
+        assert len(steps) and np.all(np.diff(times) > 0)
+        assert pv.get_reader(str(pvd)).time_values == times
+        out = []
+        for t, f in zip(times, files):
+            mesh = pv.read(pvd.parent / f)
+            tri = np.asarray(mesh.GetPolys().GetConnectivityArray()).reshape(-1, 3)
+            assert len(tri) and np.unique(tri).size == mesh.n_points
+            out.append((t, mesh))
+        return out
+
+    return read

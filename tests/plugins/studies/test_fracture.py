@@ -9,17 +9,39 @@ import xarray as xr
 
 
 def test_a_path_grows_the_crack_irreversibly_and_resumes_exactly(tmp_path, run_plate,
-                                                                  interrupt_fracture):
+                                                                  interrupt_fracture,
+                                                                  paraview_series):
     """One test, so that the path is computed once per worker: the checks below, then the
     same path killed after two increments and resumed."""
     full = run_plate(tmp_path / "full")
-    import pyvista as pv
-
-    last = pv.read(tmp_path / "full" / "snapshots" / "increment_0005.vtp")
-    np.testing.assert_array_equal(last.point_data["phase_field"], full["phase_field"][-1])
+    series = paraview_series(tmp_path / "full" / "fracture.pvd")
+    _check_snapshots(series, full)
     _check_growth(full)
     _check_energies(full)
     _check_resume(tmp_path, run_plate, interrupt_fracture, full)
+    # the resumed run's ParaView series is the uninterrupted one's
+    assert (tmp_path / "b" / "fracture.pvd").read_text() == \
+        (tmp_path / "full" / "fracture.pvd").read_text()
+    for (_, a), (_, b) in zip(paraview_series(tmp_path / "b" / "fracture.pvd"), series):
+        for name in ("phase_field", "u", "deformed"):
+            np.testing.assert_array_equal(a.point_data[name], b.point_data[name])
+
+
+def _check_snapshots(series, full):
+    """fracture.pvd: the six increments at timestep t, each .vtp with υ and u of the
+    results (the plate's 441 points, 2 · 20² triangles) and their units."""
+    assert [t for t, _ in series] == full["load_factor"].values.tolist()
+    assert series[0][0] == 0.0 and series[-1][0] == pytest.approx(0.55)
+    for k, (t, mesh) in enumerate(series):
+        assert mesh.n_cells == 2 * 20 ** 2
+        np.testing.assert_array_equal(mesh.points, full["position"].values)
+        np.testing.assert_array_equal(mesh.point_data["phase_field"], full["phase_field"][k])
+        np.testing.assert_array_equal(mesh.point_data["u"], full["displacement"][k])
+        assert mesh.field_data["TimeValue"][0] == t == mesh.field_data["load_factor"][0]
+        # the run's SI units (results.nc's; this in-process Dataset keeps the quantity)
+        assert mesh.field_data["u_quantity"][0] == full["displacement"].attrs["units"]
+        assert mesh.field_data["u_units"][0] == "m"
+        assert mesh.field_data["phase_field_units"][0] == "1"
 
 
 def _check_growth(full):

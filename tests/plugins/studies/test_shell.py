@@ -27,10 +27,40 @@ def test_plate_run_writes_results_vtp_and_report(tmp_path, run_cli):
     # the default solver 'auto' is PARDISO when pypardiso is installed, and the run says so
     assert ds.attrs["linear_solver"] == resolve_backend("auto")
     assert ds["displacement_field"].dims == ("point", "dim")
-    assert (run_dir / "shell.vtp").stat().st_size > 0
+    _check_vtp(run_dir / "shell.vtp", ds)
     r = run_cli("pointatlas-report", str(run_dir), cwd=tmp_path)
     assert r.returncode == 0, r.stderr[-2000:]
     assert "Deformed shape" in (run_dir / "report.html").read_text()
+
+
+def _check_vtp(path, ds):
+    """shell.vtp: the plate's triangles over every point, none degenerate, and the run's
+    results with their units (what ParaView shows)."""
+    import pyvista as pv
+
+    mesh = pv.read(path)
+    X = ds["position"].values
+    np.testing.assert_array_equal(mesh.points, X)
+    tri = np.asarray(mesh.GetPolys().GetConnectivityArray()).reshape(-1, 3)
+    assert len(tri) == mesh.n_cells == 2 * 13 ** 2        # 14 × 14 points on the quarter
+    assert np.unique(tri).size == len(X)
+    area = 0.5 * np.linalg.norm(np.cross(X[tri[:, 1]] - X[tri[:, 0]],
+                                         X[tri[:, 2]] - X[tri[:, 0]]), axis=1)
+    assert area.min() > 0 and area.sum() == pytest.approx(25.0, rel=1e-12)
+    u = ds["displacement_field"].values
+    np.testing.assert_array_equal(mesh.point_data["u"], u)
+    np.testing.assert_allclose(mesh.point_data["u_magnitude"], np.linalg.norm(u, axis=1))
+    mag = ds.attrs["magnification"]
+    assert mesh.field_data["magnification"][0] == pytest.approx(mag)
+    np.testing.assert_allclose(mesh.point_data["deformed"], X + mag * u)
+    # the units of results.nc (the run's units_system: SI) and the quantity they came from
+    attrs = ds["displacement_field"].attrs
+    assert (attrs["units"], attrs["quantity"]) == ("m", "length")
+    for name in ("u", "u_magnitude", "deformed"):
+        assert mesh.field_data[f"{name}_units"][0] == "m"
+        assert mesh.field_data[f"{name}_quantity"][0] == "length"
+    assert mesh.field_data["on_boundary_units"][0] == "1"
+    assert mesh.field_data["units_system"][0] == ds.attrs["units_system"] == "SI"
 
 
 def _sweep(dofs, disps, refs=(1.0, 1.01)):

@@ -1,4 +1,5 @@
 """The nonlinear shell study from the command line: increments, monitors, resume."""
+import numpy as np
 import pytest
 import xarray as xr
 
@@ -8,7 +9,7 @@ ARGS = ["experiment=shell_open_hemisphere", "source.n_points=200", "study.n_incr
         "study.max_load_factor=0.1", "study.quadrature_order=4", "quiet=true"]
 
 
-def test_open_hemisphere_path_and_resume(tmp_path, run_cli):
+def test_open_hemisphere_path_and_resume(tmp_path, run_cli, paraview_series):
     out = tmp_path / "out"
     r = run_cli("pointatlas", *ARGS, f"outputs_root={out}", cwd=tmp_path)
     assert r.returncode == 0, r.stderr[-2000:]
@@ -23,6 +24,8 @@ def test_open_hemisphere_path_and_resume(tmp_path, run_cli):
     assert int(ds["stable"].min()) == 1
     with xr.open_dataset(run_dir / "increments.nc") as inc:
         assert inc.sizes["increment"] == 2 and "nodal_displacement" in inc
+    series = paraview_series(run_dir / "shell_nonlinear.pvd")
+    _check_snapshots(series, ds)
     # resuming the finished path gives its results again, every increment included
     r = run_cli("pointatlas", *ARGS, f"study.resume_from={run_dir}",
                 f"outputs_root={tmp_path / 'out2'}", cwd=tmp_path)
@@ -31,12 +34,40 @@ def test_open_hemisphere_path_and_resume(tmp_path, run_cli):
     assert resumed["load_factor"].values.tolist() == pytest.approx([0.05, 0.1])
     assert resumed["radial_displacement"].values == pytest.approx(
         ds["radial_displacement"].values, abs=1e-12)
+    # ... and its ParaView series: the same collection, the same arrays
+    resumed_dir = next((tmp_path / "out2").glob("runs/*/*"))
+    assert (resumed_dir / "shell_nonlinear.pvd").read_text() == \
+        (run_dir / "shell_nonlinear.pvd").read_text()
+    for (t, a), (s, b) in zip(paraview_series(resumed_dir / "shell_nonlinear.pvd"), series):
+        assert t == s and set(a.array_names) == set(b.array_names)
+        for name in ("u", "energy_density", "bending_fraction"):
+            np.testing.assert_allclose(a.point_data[name], b.point_data[name], rtol=0,
+                                       atol=1e-12 * np.abs(b.point_data[name]).max())
     # a resume with another path is refused, naming the setting (one line, no traceback)
     r = run_cli("pointatlas", *ARGS[:-2], "study.max_load_factor=0.15", "study.n_increments=3",
                 f"study.resume_from={run_dir}", f"outputs_root={tmp_path / 'out3'}",
                 "quiet=true", cwd=tmp_path)
     assert r.returncode != 0 and "Traceback" not in r.stderr
     assert "study.max_load_factor = 0.1" in r.stderr and "study.max_load_factor = 0.15" in r.stderr
+
+
+def _check_snapshots(series, ds):
+    """One .vtp per increment at timestep λ holding the Dataset's fields with its units."""
+    assert [t for t, _ in series] == ds["load_factor"].values.tolist() == \
+        pytest.approx([0.05, 0.1])
+    for k, (_, mesh) in enumerate(series):
+        np.testing.assert_array_equal(mesh.points, ds["position"].values)
+        u = ds["displacement_field"].values[k]
+        np.testing.assert_array_equal(mesh.point_data["u"], u)
+        np.testing.assert_allclose(mesh.point_data["u_magnitude"], np.linalg.norm(u, axis=1))
+        for name in ("energy_density", "bending_fraction"):
+            np.testing.assert_array_equal(mesh.point_data[name], ds[name].values[k])
+            assert mesh.field_data[f"{name}_units"][0] == ds[name].attrs["units"]
+        assert mesh.field_data["u_units"][0] == ds["displacement_field"].attrs["units"] == "m"
+        assert mesh.field_data["energy_density_units"][0] == "J m-2"
+        assert mesh.field_data["load_factor"][0] == ds["load_factor"].values[k]
+        assert mesh.field_data["load"][0] == pytest.approx(ds["load"].values[k])
+        assert mesh.field_data["load_units"][0] == "N"
 
 
 def test_nonlinear_run_on_a_vtp_point_cloud_needs_no_code(tmp_path, run_cli):

@@ -17,6 +17,8 @@ SMALL = ["experiment=shell_open_hemisphere", "source.n_points=200", "study.quadr
          "study.n_increments=3", "study.max_load_factor=0.05"]
 #: wall-clock variables, the only ones a resumed run may not repeat
 WALL_TIME = {"increment_time", "time_per_newton_iteration"}
+#: the ParaView collection of the path's snapshots/increment_NNNN.vtp
+PVD = "shell_nonlinear.pvd"
 
 
 class Killed(BaseException):
@@ -57,6 +59,9 @@ def _run_keeping_increments_after(monkeypatch, run_dir, n, saved_dir, *overrides
         if len(records) == n:
             saved_dir.mkdir(parents=True)
             shutil.copy2(path, saved_dir / path.name)
+            # and the ParaView series as it is then (increment n's .vtp comes next)
+            shutil.copytree(path.parent / "snapshots", saved_dir / "snapshots")
+            shutil.copy2(path.parent / PVD, saved_dir / PVD)
 
     monkeypatch.setattr(store, "write_increments", write_and_keep)
     try:
@@ -80,7 +85,8 @@ def _assert_same_results(resumed, full):
 
 
 @pytest.mark.parametrize("control", ["force", "arc_length"])
-def test_a_resumed_path_gives_the_uninterrupted_results(tmp_path, monkeypatch, control):
+def test_a_resumed_path_gives_the_uninterrupted_results(tmp_path, monkeypatch, control,
+                                                        paraview_series):
     extra = [f"study.control={control}"]
     full = _run_keeping_increments_after(monkeypatch, tmp_path / "full", 2, tmp_path / "killed",
                                          *extra)
@@ -88,9 +94,32 @@ def test_a_resumed_path_gives_the_uninterrupted_results(tmp_path, monkeypatch, c
     assert np.isfinite(float(full["max_relative_error"]))
     resumed = _run(tmp_path / "resumed", *extra, f"study.resume_from={tmp_path / 'killed'}")
     _assert_same_results(resumed, full)
+    _assert_same_series(paraview_series, tmp_path, full, control)
     # the resumed run's own increments.nc holds the whole path too (it can be resumed again)
     with xr.open_dataset(tmp_path / "resumed" / "increments.nc") as inc:
         assert inc.sizes["increment"] == full.sizes["increment"]
+
+
+def _assert_same_series(read, tmp_path, full, control):
+    """The killed run's .pvd lists the increments whose .vtp were complete (the kill came
+    after increments.nc held 2, before the second .vtp); the resumed run's series is the
+    uninterrupted one's: the same .pvd, the same arrays."""
+    killed = read(tmp_path / "killed" / PVD)
+    assert len(killed) == 1
+    assert [p.name for p in (tmp_path / "killed" / "snapshots").iterdir()] == \
+        ["increment_0000.vtp"]
+    a, b = read(tmp_path / "full" / PVD), read(tmp_path / "resumed" / PVD)
+    assert (tmp_path / "resumed" / PVD).read_text() == (tmp_path / "full" / PVD).read_text()
+    # timestep λ under force control; the increment index under arc length
+    lam = full["load_factor"].values
+    assert [t for t, _ in a] == (lam.tolist() if control == "force" else [0.0, 1.0, 2.0])
+    for k, ((_, x), (_, y)) in enumerate(zip(a, b)):
+        assert x.array_names == y.array_names
+        for name in ("u", "u_magnitude", "energy_density", "bending_fraction"):
+            scale = max(float(np.abs(x.point_data[name]).max()), 1.0)
+            np.testing.assert_allclose(y.point_data[name], x.point_data[name], rtol=0,
+                                       atol=1e-8 * scale, err_msg=name)
+        np.testing.assert_array_equal(x.point_data["u"], full["displacement_field"].values[k])
 
 
 def test_a_resume_with_other_settings_is_refused_naming_the_key(tmp_path, monkeypatch):
@@ -150,9 +179,12 @@ def test_an_interrupted_write_keeps_the_saved_increments_and_is_cleaned(tmp_path
     records = store.read_increments(run_dir, store.run_settings(ctx))
     assert [r.load_factor for r in records] == pytest.approx([0.05 / 3])
     assert records[0].state is not None and records[0].reactions is not None
-    assert sorted(p.name for p in run_dir.iterdir()) == ["increments.nc"]
+    # what is left: the saved increment and its ParaView snapshot, listed in the .pvd
+    kept = ["increments.nc", PVD, "snapshots"]
+    assert sorted(p.name for p in run_dir.iterdir()) == kept
+    assert [p.name for p in (run_dir / "snapshots").iterdir()] == ["increment_0000.vtp"]
     # and so does the start of a run in that directory (here one that stops at once)
     (run_dir / ".increments.nc.ba9876543210.tmp").write_bytes(b"")
     with pytest.raises(InputError):
         _run(run_dir, "study.resume_from=/nonexistent")
-    assert sorted(p.name for p in run_dir.iterdir()) == ["increments.nc"]
+    assert sorted(p.name for p in run_dir.iterdir()) == kept

@@ -118,6 +118,11 @@ class ShellStudy:
         umax = float(ds["max_displacement"])
         mag = self.magnification or (0.1 * size / umax if umax > 0 else 1.0)
         ds.attrs["magnification"] = mag
+        triangles = getattr(physics, "surface_triangles", None)
+        if triangles is not None:  # the report draws the surface, not dots
+            ds["surface_triangle"] = (("triangle", "corner"), np.asarray(triangles(), np.int64), {
+                "long_name": "triangles of the sampled surface (indices of points)",
+                "units": "1"})
         ds.attrs["title"] = f"Kirchhoff–Love shell: {cloud.name}, {int(ds['dof'])} DOF"
         if self.write_vtp:
             from pointatlas_kit.paraview import units_system_of
@@ -129,8 +134,9 @@ class ShellStudy:
     def report_figures(ds):
         from .shell_figures import deformed_picture
 
-        return [("Deformed shape (displacement magnified "
-                 f"{float(ds.attrs.get('magnification', 1.0)):.3g}×)", deformed_picture(ds))]
+        return [("Deformed surface coloured by |u|, the undeformed one as grey edges "
+                 f"(displacement drawn at {float(ds.attrs.get('magnification', 1.0)):.3g} "
+                 "times its size)", deformed_picture(ds))]
 
     @staticmethod
     def report_sweep_figures(ds):

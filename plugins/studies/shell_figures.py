@@ -120,8 +120,10 @@ def snapshot_figure(points, displacements, densities, titles, window=None,
 
 
 def deformed_picture(ds, window=(900, 700)) -> bytes:
-    """Off-screen pyvista picture (PNG bytes) of the deformed points of a results Dataset,
-    displacement magnified by ``attrs['magnification']``, coloured by |u|."""
+    """Off-screen pyvista picture (PNG bytes) of a results Dataset: the deformed surface
+    (``surface_triangle``; the points when there is none), displacement drawn at
+    ``attrs['magnification']`` times its size, coloured by |u| with its units, and the
+    undeformed surface's edges in grey."""
     os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
     import io
 
@@ -131,13 +133,29 @@ def deformed_picture(ds, window=(900, 700)) -> bytes:
     x = ds["position"].values
     u = ds["displacement_field"].values
     mag = float(ds.attrs.get("magnification", 1.0))
-    cloud = pv.PolyData(np.ascontiguousarray(x + mag * u))
-    cloud.point_data["|u|"] = np.linalg.norm(u, axis=1)
+    units = str(ds["displacement_field"].attrs.get("units", ""))
+    title = f"u magnitude [{units}]" if units and units != "1" else "u magnitude"
+    bar = {"title": title, "color": "black", "vertical": True, "position_x": 0.80,
+           "position_y": 0.15, "height": 0.7, "width": 0.06, "title_font_size": 18,
+           "label_font_size": 14, "fmt": "%.3g"}
     plotter = pv.Plotter(off_screen=True, window_size=window)
     plotter.set_background("white")
-    plotter.add_mesh(cloud, scalars="|u|", render_points_as_spheres=True, point_size=8,
-                     cmap="viridis", scalar_bar_args={"title": "|u|", "color": "black"})
+    if "surface_triangle" in ds and ds.sizes.get("triangle", 0):
+        tri = np.asarray(ds["surface_triangle"].values, np.int64)
+        faces = np.hstack([np.full((len(tri), 1), 3), tri]).ravel()
+        before = pv.PolyData(np.ascontiguousarray(x), faces)
+        after = pv.PolyData(np.ascontiguousarray(x + mag * u), faces)
+        after.point_data[title] = np.linalg.norm(u, axis=1)
+        plotter.add_mesh(before.extract_all_edges(), color="grey", opacity=0.25, line_width=1)
+        plotter.add_mesh(after, scalars=title, cmap="viridis", smooth_shading=True,
+                         scalar_bar_args=bar)
+    else:
+        cloud = pv.PolyData(np.ascontiguousarray(x + mag * u))
+        cloud.point_data[title] = np.linalg.norm(u, axis=1)
+        plotter.add_mesh(cloud, scalars=title, render_points_as_spheres=True, point_size=8,
+                         cmap="viridis", scalar_bar_args=bar)
     plotter.view_isometric()
+    plotter.camera.zoom(0.85)  # room for the colour bar
     image = plotter.screenshot(return_img=True)
     plotter.close()
     buf = io.BytesIO()

@@ -30,7 +30,10 @@ def test_plate_run_writes_results_vtp_and_report(tmp_path, run_cli):
     _check_vtp(run_dir / "shell.vtp", ds)
     r = run_cli("pointatlas-report", str(run_dir), cwd=tmp_path)
     assert r.returncode == 0, r.stderr[-2000:]
-    assert "Deformed shape" in (run_dir / "report.html").read_text()
+    html_text = (run_dir / "report.html").read_text()
+    assert "Deformed surface" in html_text and html_text.index("Result") < html_text.index("Figures")
+    # the report draws the surface: its triangles cover every sampled point
+    assert np.unique(ds["surface_triangle"].values).size == int(ds["n_points"])
 
 
 def _check_vtp(path, ds):

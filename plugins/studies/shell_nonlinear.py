@@ -177,12 +177,33 @@ class ShellNonlinearStudy:
         self._has_loads = model.has_loads
         series = self._series(ctx, physics, model, records)
 
+        total = (f"at most {self.max_increments}" if self.control == "arc_length"
+                 else f"{self.n_increments} planned, more if a step is cut")
+        clock = {}
+
+        def eta(load_factor: float) -> str:
+            """Time left from the λ progress since the first increment (JIT excluded)."""
+            import time
+
+            from pointatlas.progress import format_seconds
+
+            now, frac = time.perf_counter(), load_factor / self.max_load_factor
+            if "t" not in clock:
+                clock.update(t=now, frac=frac)
+                return "ETA ?"
+            done = frac - clock["frac"]
+            if done <= 0 or frac >= 1:
+                return "ETA ?" if frac < 1 else "ETA 0s"
+            return f"ETA {format_seconds((now - clock['t']) / done * (1 - frac))}"
+
         def keep(inc):
             records.append(inc)
             values.append(probe(inc.U))
             self._fields.append(fields(inc.U))
-            ctx.log.info("increment %d: λ = %.5g, %d Newton iterations, %s; %s", len(records),
-                         inc.load_factor, inc.iterations, "stable" if inc.stable else "UNSTABLE",
+            ctx.log.info("increment %d (%s): λ = %.5g of %.5g, %d Newton iterations, %s, %s; %s",
+                         len(records), total, inc.load_factor, self.max_load_factor,
+                         inc.iterations,
+                         "stable" if inc.stable else "UNSTABLE", eta(inc.load_factor),
                          ", ".join(f"{n} = {v:.5g}" for n, v in zip(names, values[-1])))
             self._write(ctx.run_dir / "increments.nc", model, records, values, names, settings)
             if series is not None:

@@ -312,7 +312,14 @@ def main(argv: list[str] | None = None) -> None:
     if sweep_guard.CURRENT.get("sweep_dir") is not None:
         from .sweep import write_sweep
 
-        path = write_sweep(sweep_guard.CURRENT["sweep_dir"], sweep_guard.CURRENT.get("sweep_id"))
+        try:
+            path = write_sweep(sweep_guard.CURRENT["sweep_dir"],
+                               sweep_guard.CURRENT.get("sweep_id"))
+        except Exception as exc:  # noqa: BLE001 - the jobs are done; sweep.nc is a convenience
+            print(f"pointatlas: warning: the sweep's jobs finished but sweep.nc could not be "
+                  f"written ({type(exc).__name__}: {exc}); open_sweep reads the jobs instead.",
+                  file=sys.stderr)
+            path = None
         if path is not None:
             log.info("sweep %s: %s", sweep_guard.CURRENT.get("sweep_id") or "", path)
 

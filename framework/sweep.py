@@ -122,7 +122,7 @@ def _assemble(sweep_dir: Path) -> xr.Dataset:
     keys = swept_parameters(overrides)
     values = [[typed(dict(map(parse_override, ov)).get(k, "")) for k in keys] for ov in overrides]
     stacked = xr.concat(
-        [ds.drop_attrs(deep=False) for ds in runs],
+        [_indexed(ds.drop_attrs(deep=False)) for ds in runs],
         dim="run", coords="minimal", compat="override", join="outer",
     )
     names = [dim_name(k, stacked.variables) for k in keys]
@@ -154,6 +154,13 @@ def _assemble(sweep_dir: Path) -> xr.Dataset:
                                          for d, ds in zip(dirs, runs)])
     out.attrs["sweep_dir"] = str(sweep_dir)
     return out
+
+
+def _indexed(ds: xr.Dataset) -> xr.Dataset:
+    """Dims without a coordinate get 0..n-1, so that runs whose sizes differ there (a mesh
+    of another size) are padded instead of refused."""
+    bare = {d: np.arange(n) for d, n in ds.sizes.items() if d not in ds.coords}
+    return ds.assign_coords(bare) if bare else ds
 
 
 def _restore_integers(out: xr.Dataset, runs: list[xr.Dataset]) -> None:

@@ -39,3 +39,16 @@ def test_non_grid_sweep_uses_run_dim(tmp_path):
     ds = pointatlas.open_sweep(tmp_path)
     assert ds["err"].dims == ("run",)
     assert list(ds["a"].values) == [1, 2, 1]
+
+
+def test_runs_of_different_mesh_sizes_are_padded(tmp_path):
+    xr = __import__("xarray")
+    for k, n in enumerate((2, 3)):
+        ds = xr.Dataset({"err": ((), float(n), {"long_name": "error", "units": "1"}),
+                         "tri": (("triangle", "corner"), np.arange(3 * n).reshape(n, 3),
+                                 {"long_name": "triangles", "units": "1"})})
+        write_results(ds, tmp_path / str(k) / "results.nc",
+                      {"overrides": [f"source.n_points={n}"], "status": "completed"})
+    ds = pointatlas.open_sweep(tmp_path)
+    assert ds["tri"].shape == (2, 3, 3) and np.isnan(ds["tri"].values[0, 2]).all()
+    assert ds["err"].dtype.kind == "f" and list(ds["err"].values) == [2.0, 3.0]

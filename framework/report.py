@@ -201,17 +201,28 @@ def build_run_report(ds, run_dir: str | os.PathLike | None = None) -> Report:
 
 
 def build_sweep_report(ds, sweep_dir: str | os.PathLike | None = None,
-                       generic: bool = True) -> Report:
+                       generic: bool | None = None) -> Report:
     """Report of a sweep from :func:`pointatlas.open_sweep`'s Dataset: the study's sweep
     figures first, the runs, then (``generic``) each metric that varies against each swept
-    numeric parameter, then what was run."""
+    numeric parameter, then what was run.
+
+    ``generic=None`` (the default) adds those generic plots only when no plugin supplied a
+    sweep figure of its own, and otherwise says how to get them (``pointatlas-report
+    --generic-plots``); ``True`` / ``False`` always / never add them."""
     title = str(ds.attrs.get("title") or "pointatlas sweep")
     report = Report(f"Sweep: {title}")
     params = sweep_params(ds)
     records = sweep_records(ds)
     intro = Text(f"{len(records)} runs; swept parameters: {', '.join(params) or '(none)'}.")
     figures = plugin_figures(ds, "report_sweep_figures")
-    report.sections.append(Section("Figures", [intro, *figures] if figures else [intro]))
+    hint: list[Block] = []
+    if generic is None:
+        generic = not any(isinstance(block, Image) for block in figures)
+        if not generic:
+            hint = [Text("Generic plots (each metric that varies against each swept parameter) "
+                         "are left out because the plugins supplied their own sweep figures; "
+                         "add them with: pointatlas-report --generic-plots")]
+    report.sections.append(Section("Figures", [intro, *figures, *hint]))
     report.sections.append(Section("Runs", [_records_table(records)] if records else [Text("No runs.")]))
     table = metrics_table(ds)
     if table:

@@ -1,8 +1,13 @@
-"""``pointatlas-report PATH [--out DIR] [--format html,md]``: write the report of a run or sweep.
+"""``pointatlas-report PATH [--out DIR] [--format html,md] [--generic-plots]``: write the
+report of a run or sweep.
 
 PATH is a run directory (it holds ``results.nc``), a ``results.nc`` file, or a sweep directory
 (its sub-directories hold ``results.nc``). The report goes to ``report.html`` / ``report.md``
 in ``--out`` (default: PATH, or the folder of a ``results.nc`` file).
+
+A sweep report shows the study's own sweep figures first. The generic plots (each metric that
+varies against each swept numeric parameter) are added only when no plugin supplied sweep
+figures, unless ``--generic-plots`` (always) or ``--no-generic-plots`` (never) is given.
 """
 from __future__ import annotations
 
@@ -59,8 +64,11 @@ def parse_formats(text: str) -> tuple[str, ...]:
 
 
 def make_report(path: str | Path, out: str | Path | None = None,
-                formats: tuple[str, ...] = ("html", "md")) -> list[Path]:
-    """Open PATH (run or sweep), build its report and write it; return the written files."""
+                formats: tuple[str, ...] = ("html", "md"),
+                generic: bool | None = None) -> list[Path]:
+    """Open PATH (run or sweep), build its report and write it; return the written files.
+    ``generic`` is :func:`pointatlas.report.build_sweep_report`'s (None: only when the study
+    has no sweep figures of its own); a run report has no generic plots."""
     from .report import build_run_report, build_sweep_report, write_report
 
     path = Path(path)
@@ -68,7 +76,7 @@ def make_report(path: str | Path, out: str | Path | None = None,
     if kind == "run":
         report = build_run_report(_open_run(path), directory)
     else:
-        report = build_sweep_report(_open_sweep(directory), directory)
+        report = build_sweep_report(_open_sweep(directory), directory, generic=generic)
     return write_report(report, Path(out) if out is not None else directory, formats)
 
 
@@ -80,9 +88,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("path", help="run directory, results.nc file, or sweep directory")
     parser.add_argument("--out", default=None, help="output directory (default: PATH)")
     parser.add_argument("--format", default="html,md", help="comma-separated: html, md (default: html,md)")
+    parser.add_argument(
+        "--generic-plots", action=argparse.BooleanOptionalAction, default=None,
+        help="sweeps: add a plot of each metric that varies against each swept numeric "
+             "parameter (--no-generic-plots: never). Default: only when the study supplies "
+             "no sweep figures of its own. Ignored for a run.")
     args = parser.parse_args(argv)
     try:
-        written = make_report(args.path, args.out, parse_formats(args.format))
+        written = make_report(args.path, args.out, parse_formats(args.format), args.generic_plots)
     except PointatlasError as exc:
         print(f"pointatlas-report: error: {exc}", file=sys.stderr)
         return 1

@@ -140,17 +140,35 @@ def check_source(cls: type, **kwargs: Any) -> None:
         f"{cls.__name__}: the same rng seed must give the same points"))
 
 
-def check_embedder(cls: type, **kwargs: Any) -> None:
+def check_embedder(cls: type, *, transform_rtol: float = 1e-8, **kwargs: Any) -> None:
+    """The plugin contract, ``fit`` / ``embedding_`` / ``fit_transform`` on a 400-point swiss
+    roll, NaN refused; and, for an embedder with ``transform`` (out-of-sample embedding), after
+    ``fit(X)``:
+
+    - ``transform(X[:k])`` of training points has shape (k, n_components), is finite and gives
+      back ``embedding_[:k]`` to within ``transform_rtol`` times the embedding's spread (RMS
+      distance of ``embedding_`` to its centroid). The default asks for an exact reproduction;
+      an extension that only approximates training points by design (LLE's barycentric map
+      reproduces y_i up to the LLE residual) passes the bound it guarantees;
+    - new points near training points (moved 5% of their nearest-neighbour distance) land within
+      a tenth of the spread of those points' embeddings: ``transform`` is an extension of the
+      embedding, not a look-up of the training points;
+    - ``transform`` of a point with a NaN coordinate raises ``ValueError``.
+
+    An embedder without ``transform`` (allowed: ``fit`` / ``embedding_`` is the protocol) skips
+    these. ``kwargs``: Config values to use.
+    """
     check_contract(cls)
+    name = cls.__name__
     X = _swiss_roll()
     est = cls(**kwargs)
-    assert est.fit(X) is est, f"{cls.__name__}.fit must return self"
+    assert est.fit(X) is est, f"{name}.fit must return self"
     Y = np.asarray(est.embedding_)
     d = getattr(est, "n_components", 2)
-    assert Y.shape == (len(X), d), f"{cls.__name__}.embedding_ has shape {Y.shape}, not {(len(X), d)}"
-    assert np.isfinite(Y).all(), f"{cls.__name__} produced non-finite embedding values"
+    assert Y.shape == (len(X), d), f"{name}.embedding_ has shape {Y.shape}, not {(len(X), d)}"
+    assert np.isfinite(Y).all(), f"{name} produced non-finite embedding values"
     Z = np.asarray(cls(**kwargs).fit_transform(X))
-    assert Z.shape == Y.shape, f"{cls.__name__}.fit_transform must return (n, n_components)"
+    assert Z.shape == Y.shape, f"{name}.fit_transform must return (n, n_components)"
     bad = X.copy()
     bad[3, 1] = np.nan
     try:
@@ -158,7 +176,47 @@ def check_embedder(cls: type, **kwargs: Any) -> None:
     except (ValueError, ArithmeticError):
         pass
     else:
-        raise AssertionError(f"{cls.__name__}.fit accepted NaN coordinates; it must raise")
+        raise AssertionError(f"{name}.fit accepted NaN coordinates; it must raise")
+    if callable(getattr(est, "transform", None)):
+        _check_transform(est, X, Y, transform_rtol)
+
+
+def _check_transform(est, X: np.ndarray, Y: np.ndarray, rtol: float, k: int = 20,
+                     near_rtol: float = 0.1) -> None:
+    """``check_embedder``'s rules for ``transform`` of a fitted ``est`` (``X`` its training
+    points, ``Y`` their ``embedding_``)."""
+    from scipy.spatial import cKDTree
+
+    name = type(est).__name__
+    spread = float(np.sqrt(np.mean(np.sum((Y - Y.mean(axis=0)) ** 2, axis=1))))
+    T = np.asarray(est.transform(X[:k]))
+    assert T.shape == (k, Y.shape[1]), (
+        f"{name}.transform of {k} points has shape {T.shape}, not {(k, Y.shape[1])}")
+    assert np.isfinite(T).all(), f"{name}.transform of training points gave non-finite values"
+    worst = float(np.linalg.norm(T - Y[:k], axis=1).max())
+    assert worst <= rtol * spread, (
+        f"{name}.transform of training points is {worst / spread:.3g} x the embedding's spread "
+        f"away from their embedding_ (allowed {rtol:g}); pass transform_rtol= to check_embedder "
+        "only if your out-of-sample map reproduces training points approximately by design")
+    rng = np.random.default_rng(1)
+    step = cKDTree(X).query(X[:k], k=2)[0][:, 1]
+    u = rng.standard_normal(X[:k].shape)
+    near = X[:k] + 0.05 * step[:, None] * u / np.linalg.norm(u, axis=1, keepdims=True)
+    far = float(np.linalg.norm(np.asarray(est.transform(near)) - Y[:k], axis=1).max())
+    assert far <= near_rtol * spread, (
+        f"{name}.transform puts points 5% of a neighbour spacing from training points "
+        f"{far / spread:.3g} x the embedding's spread away from their embedding_ "
+        f"(allowed {near_rtol:g}): new points must be placed near the training points they are near")
+    bad = X[:k].copy()
+    bad[3, 1] = np.nan
+    try:
+        est.transform(bad)
+    except ValueError:
+        return
+    except Exception as exc:  # noqa: BLE001 - the wrong kind of refusal is the failure
+        raise AssertionError(f"{name}.transform of a NaN coordinate raised {type(exc).__name__} "
+                             f"({exc}); it must raise ValueError") from exc
+    raise AssertionError(f"{name}.transform accepted NaN coordinates; it must raise ValueError")
 
 
 def check_approximant(cls: type, *, dim: int = 2, reproduces_linear: bool = False, **kwargs: Any) -> None:

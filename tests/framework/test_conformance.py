@@ -15,6 +15,13 @@ SMALL = {
     ("physics", "kirchhoff_love_fracture"): {"length_scale": 0.15},   # required, no default
 }
 LINEAR = {("approximant", "lme")}
+# transform of a training point gives back its embedding exactly (to rounding: at most 1.0e-14
+# of the spread measured) for pca, isomap and nlie, under check_embedder's default 1e-8. LLE and
+# MLLE reconstruct a training point from its k nearest *other* training points, by design
+# (pointatlas_embedders.out_of_sample.lle_extension): measured on check_embedder's
+# swiss roll (seeds 0-2, with and without AIC), at most 1.8e-3 (LLE) and 9.5e-3 (MLLE) of the
+# spread; allowed about 3x that.
+TRANSFORM_RTOL = {("embedder", "lle"): 5e-3, ("embedder", "mlle"): 3e-2}
 
 
 def installed():
@@ -38,6 +45,8 @@ def test_plugin_conforms(family, name, cls, tmp_path):
         kwargs = {"n_points": 300}
     if family == "approximant":
         kwargs = {"reproduces_linear": (family, name) in LINEAR}
+    if (family, name) in TRANSFORM_RTOL:
+        kwargs = {**kwargs, "transform_rtol": TRANSFORM_RTOL[(family, name)]}
     check_plugin(family, cls, **kwargs)
 
 
@@ -56,6 +65,99 @@ def test_the_suite_catches_a_broken_embedder():
 
     with pytest.raises(AssertionError, match="must store 'n_components' unchanged"):
         check_contract(NoStore)
+
+
+# -- transform (out-of-sample embedding) of an embedder --
+
+def _pca():
+    from pointatlas.registry import load_plugin
+
+    return load_plugin("embedder", "pca")
+
+
+class _Shifted(_pca()):
+    """transform is off by 5% of the embedding's spread along its first axis."""
+
+    def transform(self, X):
+        Y = super().transform(X)
+        spread = np.sqrt(np.mean(np.sum((self.embedding_ - self.embedding_.mean(0)) ** 2, 1)))
+        return Y + [0.05 * spread, 0.0]
+
+
+class _LookUp(_pca()):
+    """transform gives back training points' embedding and 0 for any other point."""
+
+    def fit(self, X, y=None):
+        super().fit(X)
+        self._train = np.asarray(X, dtype=float)
+        return self
+
+    def transform(self, X):
+        X = self._validate_points(X, reset=False)
+        hit = (X[:, None, :] == self._train[None]).all(axis=2)
+        return np.where(hit.any(axis=1)[:, None], self.embedding_[hit.argmax(axis=1)], 0.0)
+
+
+class _AcceptsNan(_pca()):
+    def transform(self, X):
+        return np.nan_to_num((np.asarray(X, dtype=float) - self.mean_) @ self.components_.T)
+
+
+class _WrongShape(_pca()):
+    def transform(self, X):
+        return super().transform(X)[:, :1]
+
+
+@pytest.mark.parametrize("cls,message", [
+    (_Shifted, r"^_Shifted\.transform of training points is 0\.05 x the embedding's spread away"),
+    (_LookUp, r"^_LookUp\.transform puts points 5% of a neighbour spacing from training points"),
+    (_AcceptsNan, r"^_AcceptsNan\.transform accepted NaN coordinates; it must raise ValueError$"),
+    (_WrongShape, r"^_WrongShape\.transform of 20 points has shape \(20, 1\), not \(20, 2\)$"),
+])
+def test_the_suite_catches_a_broken_transform(cls, message):
+    with pytest.raises(AssertionError, match=message) as exc:
+        check_plugin("embedder", cls)
+    assert "\n" not in str(exc.value)
+
+
+def test_transform_rtol_admits_an_approximate_extension():
+    check_plugin("embedder", _Shifted, transform_rtol=0.06)  # 0.05 of the spread: allowed 0.06
+
+
+def test_an_embedder_without_transform_passes():
+    from dataclasses import dataclass
+
+    class Projection:
+        """The first two coordinates: fit / embedding_ only, no transform."""
+
+        description = "first two coordinates"
+
+        @dataclass
+        class Config:
+            n_components: int = 2
+
+        def __init__(self, *, n_components=2):
+            self.n_components = n_components
+
+        def fit(self, X):
+            X = np.asarray(X, dtype=float)
+            if not np.isfinite(X).all():
+                raise ValueError("X has NaN or inf")
+            self.embedding_ = X[:, :self.n_components]
+            return self
+
+        def fit_transform(self, X):
+            return self.fit(X).embedding_
+
+    assert not hasattr(Projection, "transform")
+    check_plugin("embedder", Projection)
+
+
+def test_the_third_party_example_embedder_passes():
+    spectral = pytest.importorskip("pointatlas_spectral.spectral",
+                                   reason="examples/third_party_plugin not installed")
+    assert not hasattr(spectral.SpectralEmbedder, "transform")
+    check_plugin("embedder", spectral.SpectralEmbedder)
 
 
 # -- the Dataset a physics' solve returns (pointatlas.physics_dataset_check) --

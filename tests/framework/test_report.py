@@ -201,6 +201,56 @@ def test_cli_sweep_2d_grid(tmp_path, fake_loader):
     assert "| 8 | 200 | 0.04 |" in md_text
 
 
+class FakeStudy:
+    """A study with its own sweep figure (one PNG)."""
+
+    @staticmethod
+    def report_sweep_figures(ds):
+        return [("study curve", _tiny_png())]
+
+
+@pytest.fixture
+def study_loader(monkeypatch):
+    """'study' resolves to FakeStudy (it has sweep figures); the other plugins fail to load."""
+
+    def load(family, name):
+        if family == "study":
+            return FakeStudy
+        raise LookupError(f"no {family} plugin {name!r} in this test")
+
+    monkeypatch.setattr(report_mod, "load_plugin", load)
+
+
+@pytest.mark.parametrize("flag, n_generic", [([], 0), (["--generic-plots"], 1), (["--no-generic-plots"], 0)])
+def test_cli_sweep_generic_plots_on_demand(tmp_path, study_loader, flag, n_generic):
+    pytest.importorskip("pointatlas.sweep")
+    make_sweep_dirs(tmp_path)
+    assert main([str(tmp_path), *flag]) == 0
+    html_text = (tmp_path / "report.html").read_text()
+    md_text = (tmp_path / "report.md").read_text()
+    # the study's figure always, first; the generic 'max_error vs source.n_points' only on demand
+    assert html_text.count("data:image/png;base64,") == 1 + n_generic
+    assert len(re.findall(r"!\[[^\]]*\]\(report_files/[^)]+\.png\)", md_text)) == 1 + n_generic
+    assert len(re.findall(r"!\[max_error vs source.n_points", md_text)) == n_generic
+    assert md_text.index("study curve") < md_text.index("Runs")
+    assert ("--generic-plots" in md_text) == (flag == [])  # the default says how to get them
+
+
+def test_sweep_report_generic_default_without_study_figures(tmp_path, fake_loader):
+    """No plugin has sweep figures: the generic plots are the report's figures by default."""
+    ds = sweep_by_hand(make_sweep_dirs(tmp_path) or tmp_path)
+    assert render_html(build_sweep_report(ds, tmp_path)).count("<img") == 1
+    assert render_html(build_sweep_report(ds, tmp_path, generic=False)).count("<img") == 0
+
+
+def test_cli_help_documents_generic_plots(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["--help"])
+    assert exc.value.code == 0
+    out = capsys.readouterr().out
+    assert "--generic-plots" in out and "--no-generic-plots" in out and "swept" in out
+
+
 @pytest.mark.parametrize("setup, message", [
     (lambda p: p / "missing", "does not exist"),
     (lambda p: p, "No results.nc"),

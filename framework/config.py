@@ -70,6 +70,8 @@ class RunConfig:
     study: Any = None
     #: the atlas settings (``atlas.gamma_lme=...``; the ``atlas`` plugin family)
     atlas: Any = None
+    #: where the per-patch work runs: local (default), dask, dask_slurm (pointatlas.executor)
+    executor: Any = None
     #: seeds every random choice of the run (numpy, random, scikit-learn, generators)
     seed: int = 0
     #: only warnings and errors in the log (no progress lines)

@@ -23,6 +23,7 @@ FAMILIES: dict[str, str] = {
     "pointatlas.physics": "physics",
     "pointatlas.studies": "study",
     "pointatlas.atlases": "atlas",
+    "pointatlas.executors": "executor",
 }
 _ALIASES = {short: group for group, short in FAMILIES.items()}
 _ALIASES.update({group.split(".", 1)[1]: group for group in FAMILIES})

@@ -13,6 +13,7 @@ import numpy as np
 
 from .context import RunContext
 from .errors import PointatlasError
+from .executor import SerialExecutor, using_executor
 from .headline import declare_headline
 from .jit_time import compile_seconds
 from .provenance import command_line, git_commit, hostname, now_iso, source_attr
@@ -91,7 +92,12 @@ def run_study(*, config: dict, choices: dict[str, str], overrides: list[str], ru
         seed_everything(seed)
         study = ctx.plugin("study")
         log.info("run %s: experiment=%s study=%s in %s", run_id, experiment, plugins["study"], run_dir)
-        ds = study.run(ctx)
+        # executor=dask: the atlas's patches and the assembly run on a Dask cluster
+        executor = ctx.plugin("executor") if plugins.get("executor") else SerialExecutor()
+        with using_executor(executor):
+            if callable(getattr(executor, "start", None)):
+                executor.start()  # a cluster that cannot be used stops the run here
+            ds = study.run(ctx)
         check_variables(ds)
         wall = time.perf_counter() - t0
         for key, value in sorted(ctx.source_info.items()):

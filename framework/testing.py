@@ -304,6 +304,46 @@ def check_atlas(cls: type, **kwargs: Any) -> None:
         f"{cls.__name__} must define settings() returning the atlas settings")
 
 
+def conformance_task(shared, item):
+    """A pure task for :func:`check_executor`: shared + item, or a failure at item 2."""
+    if item == 2:
+        raise ArithmeticError("the conformance task fails at item 2 on purpose")
+    return shared + item
+
+
+def check_executor(cls: type, **kwargs: Any) -> None:
+    """An executor maps a pure function in the order of the items, sends ``shared`` with
+    them, names the failing item in one TaskError, and closes. An executor whose workers are
+    batch jobs (it has ``job_script``) is checked by its job script instead of by running."""
+    from .executor import TaskError
+
+    check_contract(cls)
+    name = cls.__name__
+    ex = cls(**kwargs)
+    assert isinstance(getattr(ex, "distributed", None), bool), (
+        f"{name}.distributed must be a bool (whether the tasks run in other processes)")
+    if callable(getattr(ex, "job_script", None)):
+        script = ex.job_script()
+        assert isinstance(script, str) and script.startswith("#!"), (
+            f"{name}.job_script() must return the batch script (starting with #!)")
+        return
+    try:
+        out = ex.map(conformance_task, [5, 1, 7, 3], shared=10, desc="conformance",
+                     labels=["patch 0", "patch 1", "patch 2", "patch 3"])
+        assert list(out) == [15, 11, 17, 13], (
+            f"{name}.map must return fn(shared, item) in the order of the items; got {out}")
+        try:
+            ex.map(conformance_task, [0, 1, 2, 3], shared=0, desc="conformance",
+                   labels=["patch 0", "patch 1", "patch 2", "patch 3"])
+        except TaskError as exc:
+            assert "patch 2" in str(exc) and "\n" not in str(exc).strip(), (
+                f"{name}.map's error must name the failing item in one line; got {exc}")
+        else:
+            raise AssertionError(f"{name}.map ignored a task that raised")
+    finally:
+        ex.close()
+
+
 CHECKS = {
     "source": check_source,
     "embedder": check_embedder,
@@ -311,6 +351,7 @@ CHECKS = {
     "physics": check_physics,
     "study": check_study,
     "atlas": check_atlas,
+    "executor": check_executor,
 }
 
 

@@ -15,7 +15,8 @@ import numpy as np
 from scipy.sparse import csr_matrix
 from scipy.spatial import cKDTree
 
-from pointatlas.errors import InputError, PointatlasError
+from pointatlas.errors import InputError
+from pointatlas.executor import current_executor
 
 from . import differential_geometry as dg
 from . import memory_estimate as mem
@@ -23,8 +24,9 @@ from .settings import GEOMETRY_MARKERS_PER_PATCH, AtlasSettings
 from .chart import Chart, ChartQuadrature, build_chart, chart_quadrature
 from .quadrature import simplex_rule
 from .partition import embedding_defects, is_connected, partition_markers, refine_partition
-from .chart_repair import (AtlasError, EmbeddingAttempt, chart_passes, failed_patches_message,
-                           repair_embedders, serial_threads)
+from .chart_repair import (AtlasError, EmbeddingAttempt, Fresh, embed_control_set,
+                           failed_patches_message, repair_embedders)
+from . import patch_tasks
 
 
 @dataclass
@@ -60,11 +62,7 @@ class Atlas:
         return (W @ agg).tocsr()
 
     def _patch_values(self, X, members: np.ndarray) -> np.ndarray:
-        w = self.pu_.evaluate(X, order=0)
-        mask = np.zeros(self.markers_.shape[0], dtype=np.float64)
-        mask[members] = 1.0
-        rows = np.repeat(np.arange(w.n_points), np.diff(w.indptr))
-        return np.bincount(rows, weights=w.values * mask[w.indices], minlength=len(X))
+        return patch_tasks.patch_values(self.pu_, self.markers_.shape[0], members, X)
 
     # -- construction ----------------------------------------------------------------
     def _control_set(self, members: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -105,35 +103,33 @@ class Atlas:
         """Embed P_J with the configured embedder and, while the chart test fails, with the
         geodesic ones (:func:`chart_repair.repair_embedders`); cached per control set."""
         key = J.tobytes()
-        if key in self._embeddings:
-            return self._embeddings[key]
-        s, P = self.settings, self.points_[J]
-        best = None
-        for i, (name, make) in enumerate(self._repair_chain):
-            try:
-                if i == 0:                      # the configured embedder: errors are the user's
-                    xi = make(J.size).fit_transform(P)
-                else:                           # small dense problems: one thread
-                    with serial_threads():
-                        xi = make(J.size).fit_transform(P)
-            except PointatlasError:
-                if i == 0:
-                    raise
-                continue                        # e.g. a disconnected k-NN graph: next one
-            xi = np.asarray(xi, dtype=np.float64)
-            if J.size < 10:                     # too few points to test: kept as embedded
-                best = EmbeddingAttempt(name, xi, {}, True)
-                break
-            defects = embedding_defects(P, xi)
-            attempt = EmbeddingAttempt(name, xi, defects,
-                                       chart_passes(defects, s.max_stress, s.max_distortion))
-            if best is None or attempt.passed or (attempt.badness(s.max_stress, s.max_distortion)
-                                                  < best.badness(s.max_stress, s.max_distortion)):
-                best = attempt
-            if attempt.passed:
-                break
-        self._embeddings[key] = best
-        return best
+        if key not in self._embeddings:
+            s = self.settings
+            self._embeddings[key] = embed_control_set(self.points_[J], self._repair_chain,
+                                                      s.max_stress, s.max_distortion)
+        return self._embeddings[key]
+
+    def _prefetch_embeddings(self, patches: list[np.ndarray]) -> None:
+        """On a distributed executor, embed the control sets of ``patches`` (one depth of
+        the refinement) in one map; :meth:`_acceptable` then finds them cached."""
+        executor = current_executor()
+        if not executor.distributed:
+            return
+        todo: dict[bytes, np.ndarray] = {}
+        for members in patches:
+            if is_connected(self.adjacency_, members):
+                J, _ = self._control_set(members)
+                if J.tobytes() not in self._embeddings:
+                    todo.setdefault(J.tobytes(), J)
+        Js = list(todo.values())
+        s = self.settings
+        shared = {"points": self.points_, "chain": self._repair_chain,
+                  "max_stress": s.max_stress, "max_distortion": s.max_distortion}
+        attempts = executor.map(patch_tasks.embed_task, Js, shared=shared,
+                                desc="patch embeddings", costs=[len(J) ** 2 for J in Js],
+                                labels=[patch_tasks.patch_label(self.points_, J) for J in Js])
+        for J, attempt in zip(Js, attempts):
+            self._embeddings[J.tobytes()] = attempt
 
     def _acceptable(self, members: np.ndarray) -> bool:
         if not is_connected(self.adjacency_, members):
@@ -184,10 +180,11 @@ class Atlas:
         labels, self.adjacency_ = partition_markers(Q, n_parts, s.graph_neighbors)
         self.initial_n_patches_ = int(labels.max()) + 1
         self.defects_ = {}
-        self._repair_chain = repair_embedders(self.make_embedder, self.chart_dim_)
+        self._repair_chain = repair_embedders(Fresh(self.make_embedder()), self.chart_dim_)
         self.repair_embedders_ = [name for name, _ in self._repair_chain]
         self.labels_, self.accepted_, self.patch_depth_ = refine_partition(
-            labels, self.adjacency_, self._acceptable, max_depth=s.max_refinement_depth)
+            labels, self.adjacency_, self._acceptable, max_depth=s.max_refinement_depth,
+            prefetch=self._prefetch_embeddings)
         attempts = [self._patch_attempt(k) for k in range(self.accepted_.size)]
         self.patch_embedder_ = np.array(["none" if a is None else a.embedder for a in attempts])
         if not self.accepted_.all() and not s.allow_failed_patches:
@@ -246,7 +243,18 @@ class Atlas:
         per_chart = s.least_squares_scope == "chart"
         self.charts_, self.support_ = [], []
         L = int(self.labels_.max()) + 1
-        for k in progress(range(L), total=L, desc="charts"):
+        executor = current_executor()
+        if executor.distributed:
+            sets = [self._control_set(np.flatnonzero(self.labels_ == k)) for k in range(L)]
+            self.support_ = [psi for _, psi in sets]
+            shared = {"points": self.points_, "make_lme": Fresh(self.make_lme()),
+                      "least_squares_fit": s.least_squares_fit and per_chart}
+            self.charts_ = executor.map(
+                patch_tasks.chart_task, [(J, self._embedding(J)) for J, _ in sets],
+                shared=shared, desc="charts", costs=[len(J) for J, _ in sets],
+                labels=[patch_tasks.patch_label(self.points_, J, k)
+                        for k, (J, _) in enumerate(sets)])
+        for k in ([] if executor.distributed else progress(range(L), total=L, desc="charts")):
             members = np.flatnonzero(self.labels_ == k)
             J, psi = self._control_set(members)
             xi = self._embedding(J)  # the embedding the chart test accepted (chart_repair)
@@ -266,7 +274,21 @@ class Atlas:
         nodes (integrate over the sampled surface only); ``keep_basis`` keeps the basis."""
         s = self.settings
         self.quadrature_ = []
-        for k in progress(range(len(self.charts_)), total=len(self.charts_), desc="quadrature"):
+        executor = current_executor()
+        if executor.distributed:
+            shared = {"pu": self.pu_, "n_markers": self.markers_.shape[0],
+                      "order": s.quadrature_order, "tol_pu": s.tol_pu,
+                      "need_second": need_second, "keep_basis": keep_basis}
+            items = [(c, self.support_[k], np.flatnonzero(self.labels_ == k),
+                      None if real is None else np.asarray(real, bool)[c.node_index])
+                     for k, c in enumerate(self.charts_)]
+            self.quadrature_ = executor.map(
+                patch_tasks.quadrature_task, items, shared=shared, desc="quadrature",
+                costs=[len(c.node_index) for c in self.charts_],
+                labels=[patch_tasks.patch_label(self.points_, c.node_index, k)
+                        for k, c in enumerate(self.charts_)])
+        for k in ([] if executor.distributed else
+                  progress(range(len(self.charts_)), total=len(self.charts_), desc="quadrature")):
             members = np.flatnonzero(self.labels_ == k)
             J = self.charts_[k].node_index
             self.quadrature_.append(chart_quadrature(

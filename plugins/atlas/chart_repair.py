@@ -93,6 +93,58 @@ def repair_embedders(configured: Callable[[], object], d: int
     return chain
 
 
+class Fresh:
+    """A picklable factory: a fresh deep copy of ``prototype`` per call (an unfitted embedder
+    or approximant), so the factories of a run can be sent to Dask workers."""
+
+    def __init__(self, prototype):
+        self.prototype = prototype
+
+    def __call__(self, *args):
+        import copy
+
+        return copy.deepcopy(self.prototype)
+
+
+def embed_control_set(P: np.ndarray, chain, max_stress: float, max_distortion: float
+                      ) -> Optional[EmbeddingAttempt]:
+    """Embed the control points P (n, D) of a patch with the embedders of ``chain``
+    (:func:`repair_embedders`) in turn until one passes the chart test; returns the passing
+    embedding, else the least bad one. Pure: the same P gives the same attempt anywhere.
+
+    The configured (first) embedder's errors are the user's and propagate; a geodesic one
+    that fails (e.g. a disconnected k-NN graph) is skipped.
+    """
+    from pointatlas.errors import PointatlasError
+
+    from .partition import embedding_defects
+
+    best = None
+    for i, (name, make) in enumerate(chain):
+        try:
+            if i == 0:                      # the configured embedder: errors are the user's
+                xi = make(len(P)).fit_transform(P)
+            else:                           # small dense problems: one thread
+                with serial_threads():
+                    xi = make(len(P)).fit_transform(P)
+        except PointatlasError:
+            if i == 0:
+                raise
+            continue                        # e.g. a disconnected k-NN graph: next one
+        xi = np.asarray(xi, dtype=np.float64)
+        if len(P) < 10:                     # too few points to test: kept as embedded
+            return EmbeddingAttempt(name, xi, {}, True)
+        defects = embedding_defects(P, xi)
+        attempt = EmbeddingAttempt(name, xi, defects,
+                                   chart_passes(defects, max_stress, max_distortion))
+        if best is None or attempt.passed or (attempt.badness(max_stress, max_distortion)
+                                              < best.badness(max_stress, max_distortion)):
+            best = attempt
+        if attempt.passed:
+            break
+    return best
+
+
 @contextmanager
 def serial_threads():
     """One BLAS and one numba thread: a patch's embedding is a small dense problem, on which

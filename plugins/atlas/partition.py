@@ -9,7 +9,7 @@ builds the chart and measures it); :func:`embedding_defects` gives the measures.
 from __future__ import annotations
 
 import math
-from typing import Callable
+from typing import Callable, Optional
 
 import numpy as np
 from scipy.sparse import coo_matrix, csr_matrix
@@ -98,26 +98,35 @@ def partition_markers(markers: np.ndarray, n_parts: int, n_neighbors: int = 10
 
 def refine_partition(labels: np.ndarray, adjacency: csr_matrix,
                      acceptable: Callable[[np.ndarray], bool], max_depth: int = 6,
-                     min_size: int = 8) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                     min_size: int = 8, prefetch: Optional[Callable[[list], None]] = None
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Recursively bisect (METIS) every patch for which ``acceptable(marker_indices)`` fails.
 
     ``acceptable`` may itself repair the patch (re-embed it, :mod:`.chart_repair`); only a
     patch it still rejects is split. A patch with fewer than 2·min_size markers or at depth
     max_depth is kept as it is. Returns new labels 0..L'-1 and, per final patch, whether it
     passed the test and its split depth (0: a patch of the initial partition).
+
+    The patches are tested depth by depth; ``prefetch(list of marker-index arrays)`` is
+    called with each depth's patches first (the atlas embeds them there in one map on its
+    executor, :mod:`pointatlas.executor`). The result does not depend on the order.
     """
     queue = [(np.flatnonzero(labels == lab), 0) for lab in np.unique(labels)]
     final: list[tuple[np.ndarray, bool, int]] = []
     while queue:
-        idx, depth = queue.pop()
-        ok = acceptable(idx)
-        if ok or depth >= max_depth or idx.size < 2 * min_size:
-            final.append((idx, ok, depth))
-            continue
-        sub = adjacency[idx][:, idx]
-        halves = split_disconnected(sub, metis_parts(sub, 2))
-        for lab in np.unique(halves):
-            queue.append((idx[halves == lab], depth + 1))
+        if prefetch is not None:
+            prefetch([idx for idx, _ in queue])
+        split = []
+        for idx, depth in queue:
+            ok = acceptable(idx)
+            if ok or depth >= max_depth or idx.size < 2 * min_size:
+                final.append((idx, ok, depth))
+                continue
+            sub = adjacency[idx][:, idx]
+            halves = split_disconnected(sub, metis_parts(sub, 2))
+            for lab in np.unique(halves):
+                split.append((idx[halves == lab], depth + 1))
+        queue = split
     out = np.empty_like(labels)
     final.sort(key=lambda item: item[0].min())
     for k, (idx, _, _) in enumerate(final):

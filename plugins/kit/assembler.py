@@ -18,6 +18,7 @@ import numpy as np
 from scipy.sparse import bsr_matrix
 
 from pointatlas.errors import ConfigError
+from pointatlas.executor import current_executor
 
 from .assembly_kernels import jets_at, scatter_gradient, tangent_blocks
 from .assembly_plan import balanced_ranges, n_threads, run_threads
@@ -70,6 +71,7 @@ class Assembler:
             raise ConfigError(f"field(s) {unused} are declared but no energy uses them: "
                               "remove them from the physics' fields or add the energy that "
                               "needs them.")
+        self._data_version = 0
         self.part_names = [f"{type(t.energy).__name__}.{n}" if len(self.terms) > 1 else n
                            for t in self.terms for n in t.energy.density_names]
 
@@ -77,6 +79,7 @@ class Assembler:
         """Recompute every energy's point data (after the caller changed what it depends on,
         e.g. a degradation or a driving energy between the steps of a staggered solve)."""
         self.terms = [_Term(t.energy, self.layout, self.q) for t in self.terms]
+        self._data_version += 1       # a distributed executor sends the new data
 
     # -- pointwise evaluation ------------------------------------------------------------
     def _evaluate(self, points, U, want):
@@ -128,37 +131,77 @@ class Assembler:
     def residual(self, U, want_densities: bool = False):
         """(Π, R (n_dofs,)) or, with ``want_densities``, (Π, R, dens (m, n_parts))."""
         U = self.layout.as_blocks(U)
-        q, L = self.q, self.layout
-        dens = np.empty((q.n_points, len(self.part_names)))
-        ranges = balanced_ranges(np.diff(q.indptr).astype(float), n_threads(q.n_points))
-
-        def work(a0, a1):
-            f = np.zeros((L.n_nodes, L.block))
-            for a in range(a0, a1, CHUNK):
-                pts = np.arange(a, min(a + CHUNK, a1), dtype=np.int64)
-                d, g, _ = self._evaluate(pts, U, 1)
-                dens[pts] = d
-                scatter_gradient(pts, q.indptr, q.indices, q.basis, q.weights, g,
-                                 L.jet_column, L.jet_dof, f)
-            return f
-
-        parts = run_threads(work, ranges)
-        f = parts[0]
-        for extra in parts[1:]:
+        q = self.q
+        ranges = balanced_ranges(np.diff(q.indptr).astype(float), self._n_parts(q.n_points))
+        parts = self._run(residual_part, [(U, a0, a1) for a0, a1 in ranges], "residual")
+        dens = np.concatenate([d for _, d in parts]) if len(parts) > 1 else parts[0][1]
+        f = parts[0][0]
+        for extra, _ in parts[1:]:
             f += extra
         W = float((q.weights @ dens).sum())
         return (W, f.ravel(), dens) if want_densities else (W, f.ravel())
 
+    def residual_range(self, U, a0: int, a1: int):
+        """(f (n_nodes, B), dens (a1 − a0, n_parts)) of the quadrature points a0..a1."""
+        q, L = self.q, self.layout
+        f = np.zeros((L.n_nodes, L.block))
+        dens = np.empty((a1 - a0, len(self.part_names)))
+        for a in range(a0, a1, CHUNK):
+            pts = np.arange(a, min(a + CHUNK, a1), dtype=np.int64)
+            d, g, _ = self._evaluate(pts, U, 1)
+            dens[pts - a0] = d
+            scatter_gradient(pts, q.indptr, q.indices, q.basis, q.weights, g,
+                             L.jet_column, L.jet_dof, f)
+        return f, dens
+
+    # -- where the parts run -----------------------------------------------------------------
+    @staticmethod
+    def _n_parts(n_items: int) -> int:
+        """Parts of a residual or tangent: this process's threads (:func:`n_threads`), so a
+        distributed run of as many worker threads sums the same parts in the same order."""
+        return n_threads(n_items)
+
+    def _run(self, fn, items, what: str) -> list:
+        """``fn(self, item)`` for the parts: this process's threads, or tasks on the run's
+        distributed executor (:mod:`pointatlas.executor`; the assembler is sent once)."""
+        executor = current_executor()
+        if executor.distributed and len(items) > 0:
+            self.q.assembly_plan()  # computed here, sent with the assembler
+            return executor.map(fn, items, shared=self, desc=f"{what} assembly",
+                                shared_key=("assembler", id(self), self._data_version),
+                                labels=[f"{what} part {i}" for i in range(len(items))])
+        return run_threads(lambda *item: fn(self, item), items)
+
     def tangent(self, U):
         """K = ∂²Π/∂U² as scipy CSR (n_dofs, n_dofs), symmetric."""
         U = self.layout.as_blocks(U)
+        plan = self.q.assembly_plan()
+        B, N = self.layout.block, self.layout.n_nodes
+        bounds = [(int(b0), int(b1)) for b0, b1 in plan.thread_bounds]
+        items = [(U, b0, b1) for b0, b1 in bounds]
+        if current_executor().distributed:
+            parts = self._run(tangent_part, items, "tangent")
+            data = np.zeros((len(plan.cols), B, B))
+            for touched, blocks in parts:   # the parts' sums in order, as the threads' are
+                data[touched] += blocks
+        else:
+            parts = run_threads(lambda *item: self.tangent_range(*item), items)
+            data = parts[0]
+            for extra in parts[1:]:
+                data += extra
+        return bsr_matrix((data, plan.cols, plan.row_ptr), shape=(B * N, B * N),
+                          blocksize=(B, B)).tocsr()
+
+    def tangent_range(self, U, b0: int, b1: int) -> np.ndarray:
+        """(nnz_blocks, B, B): the tangent blocks of the point blocks b0..b1 of the plan."""
+        from pointatlas_atlas.chart import one_blas_thread
+
         q, L = self.q, self.layout
         plan = q.assembly_plan()
         B = L.block
-
-        def work(b0, b1):
-            data = np.zeros((len(plan.cols), B, B))
-            c0 = b0
+        data = np.zeros((len(plan.cols), B, B))
+        c0 = b0
+        with one_blas_thread():  # the point products are small: BLAS threads only contend
             while c0 < b1:  # chunks of blocks holding about CHUNK points
                 first = plan.block_ptr[c0]
                 c1 = int(np.searchsorted(plan.block_ptr, first + CHUNK, side="right")) - 1
@@ -167,18 +210,21 @@ class Assembler:
                 _, _, H = self._evaluate(pts, U, 2)
                 tangent_blocks(c0, c1, plan.order, plan.block_ptr, np.int64(first), q.indptr,
                                q.indices, q.basis, q.weights, H, L.jet_column, L.jet_dof,
-                               *L.field_tables,
-                               int(B), int(L.jet_size), plan.row_ptr, plan.cols, np.int64(L.n_nodes), data)
+                               *L.field_tables, int(B), int(L.jet_size), plan.row_ptr,
+                               plan.cols, np.int64(L.n_nodes), data)
                 c0 = c1
-            return data
+        return data
 
-        from pointatlas_atlas.chart import one_blas_thread
 
-        with one_blas_thread():  # the point products are small: BLAS threads only contend
-            parts = run_threads(work, [tuple(int(x) for x in r) for r in plan.thread_bounds])
-        data = parts[0]
-        for extra in parts[1:]:
-            data += extra
-        N = L.n_nodes
-        return bsr_matrix((data, plan.cols, plan.row_ptr), shape=(B * N, B * N),
-                          blocksize=(B, B)).tocsr()
+def residual_part(assembler: Assembler, item):
+    """One part of :meth:`Assembler.residual` (a task: item = (U, a0, a1))."""
+    return assembler.residual_range(*item)
+
+
+def tangent_part(assembler: Assembler, item):
+    """One part of :meth:`Assembler.tangent` as a task (item = (U, b0, b1)): (touched,
+    blocks), the indices of the pattern blocks it touches and those blocks (what is sent
+    back is the part's own rows, not the whole pattern)."""
+    data = assembler.tangent_range(*item)
+    touched = np.flatnonzero(np.any(data != 0.0, axis=(1, 2)))
+    return touched, data[touched]

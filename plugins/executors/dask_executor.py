@@ -1,0 +1,252 @@
+"""``executor=dask``: the per-patch work of a run on a Dask cluster (dask.distributed).
+
+The run starts a ``LocalCluster`` (``n_workers`` processes of ``threads_per_worker``
+threads) or connects to the scheduler at ``scheduler_address``; :meth:`DaskExecutor.map`
+then sends the items of a map (the atlas's patches, the assembler's point blocks) as tasks:
+
+- the ``shared`` data (the point array, the partition of unity) is scattered to every worker
+  once (``broadcast``), the items in ``tasks_per_thread`` × (worker threads) contiguous
+  batches of about equal cost, each scattered and held on two workers: no task carries its
+  data in the task graph (no "large graph" warning), and a worker lost mid-run loses no
+  data;
+- a worker that dies (``kill -9``) has its tasks re-run by Dask elsewhere: the functions are
+  pure, so the results are the same;
+- a task that raises becomes one :class:`~pointatlas.executor.TaskError` naming the item
+  (``patch 17``) and the worker with its message;
+- progress (tasks done of all, rate, ETA) is logged as the tasks finish.
+
+On connecting, the workers' pointatlas version is compared with this one (refused if they
+differ: the pickled functions are this version's).
+"""
+from __future__ import annotations
+
+import itertools
+import logging
+from dataclasses import dataclass
+from typing import ClassVar, Optional
+
+import numpy as np
+
+from pointatlas.constraints import Interval, Types
+from pointatlas.errors import ConfigError, InputError, PointatlasError
+from pointatlas.executor import TaskError
+from pointatlas.stores_config import stores_config
+
+log = logging.getLogger("pointatlas.executor")
+_TOKENS = itertools.count()
+
+
+def require_distributed():
+    """The ``distributed`` module, or a ConfigError naming the extra to install."""
+    try:
+        import distributed
+    except ImportError:
+        raise ConfigError(
+            "executor=dask needs Dask distributed, which is not installed: pip install "
+            "'pointatlas[distributed]' (or use executor=local).") from None
+    return distributed
+
+
+def balanced_batches(costs: np.ndarray, n_batches: int) -> list[tuple[int, int]]:
+    """Contiguous [start, stop) ranges over the items with about equal Σ cost each."""
+    c = np.cumsum(np.asarray(costs, dtype=np.float64))
+    total = c[-1] if len(c) else 0.0
+    cuts = np.searchsorted(c, total * np.arange(1, n_batches) / n_batches, side="right")
+    b = np.unique(np.concatenate([[0], np.minimum(cuts, len(c)), [len(c)]])).astype(int)
+    return [(int(s), int(e)) for s, e in zip(b[:-1], b[1:]) if e > s]
+
+
+def run_batch(fn, shared, payload):
+    """On a worker: ``fn(shared, item)`` for the batch's items; a failure names the item."""
+    items, labels = payload
+    out = []
+    for item, label in zip(items, labels):
+        try:
+            out.append(fn(shared, item))
+        except Exception as exc:  # noqa: BLE001 — re-raised as one line with where it happened
+            where = _worker_address()
+            what = str(exc) if isinstance(exc, PointatlasError) else f"{type(exc).__name__}: {exc}"
+            raise TaskError(f"{label} failed on worker {where}: {what}") from None
+    return out
+
+
+def _worker_address() -> str:
+    try:
+        from distributed import get_worker
+
+        return get_worker().address
+    except Exception:  # noqa: BLE001 — not on a worker (tests calling run_batch directly)
+        return "(this process)"
+
+
+def worker_version() -> str:
+    """The pointatlas version a worker imports (run on each worker at connection)."""
+    import pointatlas
+
+    return pointatlas.__version__
+
+
+@stores_config
+class DaskExecutor:
+    """Per-patch tasks on a Dask cluster (see the module docstring)."""
+
+    @dataclass
+    class Config:
+        scheduler_address: Optional[str] = None  # e.g. tcp://10.0.0.5:8786; None: a
+        #                                          LocalCluster started (and stopped) by the run
+        n_workers: int = 2                # LocalCluster: worker processes
+        threads_per_worker: int = 1       # LocalCluster: threads (and numba threads) each
+        memory_limit: str = "auto"        # LocalCluster: per worker, e.g. '4GiB'
+        connect_timeout: float = 10.0     # s to wait for the scheduler (and the workers)
+        tasks_per_thread: int = 4         # batches per worker thread and map
+        retries: int = 0                  # re-runs of a task that raised (a lost worker's
+        #                                   tasks are re-run by Dask regardless)
+
+        parameter_constraints: ClassVar[dict[str, list]] = {
+            "scheduler_address": [Types(str), None],
+            "n_workers": [Interval(int, 1, None)],
+            "threads_per_worker": [Interval(int, 1, None)],
+            "memory_limit": [Types(str)],
+            "connect_timeout": [Interval(float, 0, None, closed="neither")],
+            "tasks_per_thread": [Interval(int, 1, None)],
+            "retries": [Interval(int, 0, None)],
+        }
+
+    description: ClassVar[str] = "Per-patch tasks on a Dask cluster (LocalCluster or a scheduler)."
+    distributed: ClassVar[bool] = True
+
+    # -- connection ----------------------------------------------------------------------
+    def _start_cluster(self):
+        """The cluster this run starts (None: connect to ``scheduler_address``)."""
+        from distributed import LocalCluster
+
+        return LocalCluster(
+            n_workers=self.n_workers, threads_per_worker=self.threads_per_worker,
+            processes=True, memory_limit=self.memory_limit, dashboard_address=":0",
+            silence_logs=logging.WARNING,
+            env={"NUMBA_NUM_THREADS": str(self.threads_per_worker)})
+
+    def client(self):
+        """The Dask client, connected (and the version of the workers checked) on first use."""
+        if getattr(self, "_client", None) is not None:
+            return self._client
+        require_distributed()
+        from distributed import Client
+
+        self._cluster = None
+        for name in ("distributed", "dask_jobqueue"):  # their INFO lines drown the run's log
+            logging.getLogger(name).setLevel(logging.WARNING)
+        if self.scheduler_address:
+            try:
+                self._client = Client(self.scheduler_address,
+                                      timeout=f"{self.connect_timeout}s")
+            except (OSError, TimeoutError) as exc:
+                raise InputError(
+                    f"no Dask scheduler answers at {self.scheduler_address} (after "
+                    f"{self.connect_timeout:g} s: {type(exc).__name__}). Start one with "
+                    "`dask scheduler` and workers with `dask worker <address>`, or leave "
+                    "executor.scheduler_address unset for a local cluster.") from None
+        else:
+            self._cluster = self._start_cluster()
+            self._client = Client(self._cluster)
+        try:
+            self._check_workers()
+        except BaseException:
+            self.close()
+            raise
+        return self._client
+
+    def start(self) -> None:
+        """Connect now (the run calls this first: an unreachable scheduler or workers of
+        another version stop the run before any work)."""
+        self.client()
+
+    def _check_workers(self) -> None:
+        import pointatlas
+
+        client = self._client
+        try:
+            client.wait_for_workers(1, timeout=self.connect_timeout)
+        except (TimeoutError, OSError):
+            raise InputError(
+                f"the Dask scheduler at {client.scheduler.address} has no workers (waited "
+                f"{self.connect_timeout:g} s). Start some with `dask worker "
+                f"{client.scheduler.address}`.") from None
+        versions = client.run(worker_version)
+        other = {a: v for a, v in versions.items() if v != pointatlas.__version__}
+        if other:
+            addr, v = sorted(other.items())[0]
+            raise ConfigError(
+                f"{len(other)} of {len(versions)} Dask workers run pointatlas {v} (e.g. "
+                f"{addr}), this run pointatlas {pointatlas.__version__}: install the same "
+                "version on the workers (their environment must match the client's).")
+        threads = sum(client.nthreads().values())
+        log.info("dask: %d workers, %d threads, scheduler %s", len(versions), threads,
+                 client.scheduler.address)
+
+    def close(self) -> None:
+        client, cluster = getattr(self, "_client", None), getattr(self, "_cluster", None)
+        self._client, self._cluster, self._shared = None, None, {}
+        if client is not None:
+            client.close()
+        if cluster is not None:
+            cluster.close()
+
+    # -- work ----------------------------------------------------------------------------
+    def _scatter_shared(self, shared, key):
+        cache = getattr(self, "_shared", None)
+        if cache is None:
+            cache = self._shared = {}
+        if key is not None and key in cache:
+            return cache[key]
+        [future] = self._client.scatter([shared], broadcast=True, hash=False)
+        if key is not None:
+            cache.clear()          # one shared object kept at a time (e.g. one assembler)
+            cache[key] = future
+        return future
+
+    def map(self, fn, items, *, shared=None, shared_key=None, desc="tasks", labels=None,
+            costs=None) -> list:
+        """``[fn(shared, item) for item in items]`` as batched tasks on the cluster."""
+        from distributed import as_completed
+
+        from pointatlas.progress import Progress
+
+        items = list(items)
+        if not items:
+            return []
+        client = self.client()
+        labels = list(labels) if labels is not None else [f"item {i}" for i in range(len(items))]
+        threads = max(1, sum(client.nthreads().values()))
+        costs = np.ones(len(items)) if costs is None else np.asarray(costs, dtype=np.float64)
+        batches = balanced_batches(costs, min(len(items), self.tasks_per_thread * threads))
+        shared_future = self._scatter_shared(shared, shared_key)
+        payloads = client.scatter([(items[a:b], labels[a:b]) for a, b in batches], hash=False)
+        if threads > 1 and len(client.nthreads()) > 1:
+            client.replicate(payloads, n=2)      # a lost worker loses no batch
+        token = next(_TOKENS)
+        futures = [client.submit(run_batch, fn, shared_future, p, pure=False,
+                                 retries=self.retries, key=f"{desc}-{token}-{i}")
+                   for i, p in enumerate(payloads)]
+        index = {f.key: i for i, f in enumerate(futures)}
+        results: list = [None] * len(futures)
+        bar = Progress(total=len(futures), desc=f"{desc} on dask ({len(items)} items in "
+                                                 f"{len(futures)} tasks, {threads} threads)",
+                       logger=log)
+        try:
+            for future in as_completed(futures):
+                if future.status == "error":
+                    exc = future.exception()
+                    if isinstance(exc, PointatlasError):
+                        raise TaskError(f"{desc}: {exc}") from None
+                    raise TaskError(f"{desc}: a task failed on the cluster: "
+                                    f"{type(exc).__name__}: {exc}") from None
+                results[index[future.key]] = future.result()
+                bar.update(1)
+        finally:
+            bar.close()
+            client.cancel([f for f in futures if not f.done()])
+            if shared_key is None:
+                client.cancel([shared_future])
+            client.cancel(payloads)
+        return [r for part in results for r in part]

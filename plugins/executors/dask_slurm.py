@@ -86,7 +86,13 @@ class DaskSlurmExecutor(DaskExecutor):
             **({"python": self.python} if self.python else {}))
 
     def _start_cluster(self):
+        import shutil
+
         require_distributed()
+        if shutil.which("sbatch") is None:
+            raise ConfigError("executor=dask_slurm submits its workers with sbatch, which is not "
+                              "on the PATH here: run on a SLURM login node, or use "
+                              "executor=dask (a local cluster or executor.scheduler_address).")
         try:
             from dask_jobqueue import SLURMCluster
         except ImportError:

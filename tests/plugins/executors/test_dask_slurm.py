@@ -43,3 +43,15 @@ def test_command_line_refuses_a_bad_walltime_in_one_line(run_cli, tmp_path):
     assert r.returncode != 0 and "Traceback" not in r.stderr
     assert "executor.walltime='2h' is invalid" in r.stderr
     assert not list(tmp_path.rglob("results.nc"))
+
+
+def test_without_slurm_the_run_stops_in_one_line(run_cli, tmp_path):
+    """This machine has no sbatch: the run says so before any work (walltime read as text)."""
+    import shutil
+
+    if shutil.which("sbatch"):
+        pytest.skip("SLURM is installed here")
+    r = run_cli("pointatlas", "executor=dask_slurm", "executor.walltime=02:00:00",
+                "source.n_points=500", f"outputs_root={tmp_path}", cwd=tmp_path)
+    assert r.returncode != 0 and "Traceback" not in r.stderr
+    assert "submits its workers with sbatch, which is not on the PATH" in r.stderr

@@ -19,8 +19,6 @@ for any bias that acts on λ alone. Outside [lower, upper] λ is reflected (non-
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import numpy as np
 
 
@@ -29,58 +27,57 @@ def wrap(d, period):
     return d if period is None else (d + 0.5 * period) % period - 0.5 * period
 
 
-@dataclass
 class EABF:
-    """The extended variable, the ABF accumulators on λ and the CZAR accumulators on z.
+    """eABF on one CV: a 1-D view of :class:`.eabf_grid.EABFGrid` (one axis; the dynamics
+    and accumulators are the grid's), with scalar ``lam``, ``vel``, ``width`` and per-bin
+    ``f_sum``, ``z_lam_sum`` arrays (n_bins,).
 
     Units: ξ, λ in the CV unit [ξ]; k in kJ/mol/[ξ]²; mass in kJ/mol ps²/[ξ]²; friction
     1/ps; kT in kJ/mol; dt in ps.
     """
-    lower: float
-    upper: float
-    n_bins: int
-    k: float
-    mass: float
-    kT: float
-    friction: float = 10.0
-    full_samples: int = 200
-    period: float | None = None
-    lam: float = 0.0
-    vel: float = 0.0
-    f_sum: np.ndarray = field(init=False)
-    f_count: np.ndarray = field(init=False)
-    z_count: np.ndarray = field(init=False)
-    z_lam_sum: np.ndarray = field(init=False)
 
-    def __post_init__(self):
+    def __init__(self, lower: float, upper: float, n_bins: int, k: float, mass: float,
+                 kT: float, friction: float = 10.0, full_samples: int = 200,
+                 period: float | None = None, lam: float = 0.0, vel: float = 0.0):
         from pointatlas.errors import ConfigError
 
-        if not self.lower < self.upper:
-            raise ConfigError(f"eABF range [{self.lower:g}, {self.upper:g}] is empty; give "
+        from .eabf_grid import EABFGrid
+
+        if not lower < upper:
+            raise ConfigError(f"eABF range [{lower:g}, {upper:g}] is empty; give "
                               f"lower < upper.")
-        if not self.lower <= self.lam <= self.upper:
-            raise ConfigError(f"the starting configuration's CV value {self.lam:g} lies outside "
-                              f"the eABF range [{self.lower:g}, {self.upper:g}]; widen the "
+        if not lower <= lam <= upper:
+            raise ConfigError(f"the starting configuration's CV value {lam:g} lies outside "
+                              f"the eABF range [{lower:g}, {upper:g}]; widen the "
                               f"range or start elsewhere.")
-        self.f_sum = np.zeros(self.n_bins)
-        self.f_count = np.zeros(self.n_bins, dtype=np.int64)
-        self.z_count = np.zeros(self.n_bins, dtype=np.int64)
-        self.z_lam_sum = np.zeros(self.n_bins)
-        self.width = (self.upper - self.lower) / self.n_bins
+        self.lower, self.upper, self.n_bins = float(lower), float(upper), int(n_bins)
+        self.k, self.mass, self.kT = float(k), float(mass), float(kT)
+        self.friction, self.full_samples, self.period = float(friction), int(full_samples), period
+        self.grid = EABFGrid([lower], [upper], n_bins, k, mass, kT, friction=friction,
+                             full_samples=full_samples, periods=[period], lam=[lam])
+        self.grid.vel[0] = vel
+        self.width = float(self.grid.width[0])
+
+    # the state, as scalars and (n_bins,) arrays (views of the grid's)
+    lam = property(lambda self: float(self.grid.lam[0]),
+                   lambda self, v: self.grid.lam.__setitem__(0, v))
+    vel = property(lambda self: float(self.grid.vel[0]),
+                   lambda self, v: self.grid.vel.__setitem__(0, v))
+    f_sum = property(lambda self: self.grid.f_sum[:, 0])
+    f_count = property(lambda self: self.grid.f_count)
+    z_count = property(lambda self: self.grid.z_count)
+    z_lam_sum = property(lambda self: self.grid.z_lam_sum[:, 0])
 
     def bin(self, v: float) -> int:
         """Bin of a CV value (−1 outside a non-periodic range)."""
-        if self.period is not None:
-            v = self.lower + (v - self.lower) % self.period
-        b = int(np.floor((v - self.lower) / self.width))
-        return b if 0 <= b < self.n_bins else -1
+        return self.grid.bin([v])
 
     def centres(self) -> np.ndarray:
-        return self.lower + self.width * (np.arange(self.n_bins) + 0.5)
+        return self.grid.centres(0)
 
     def coupling(self, xi: float) -> float:
         """k (ξ − λ): the force on λ and, times −∂ξ/∂x, the force on the atoms."""
-        return self.k * wrap(xi - self.lam, self.period)
+        return float(self.grid.coupling([xi])[0])
 
     def period_of_lambda(self) -> float:
         """Oscillation period 2π √(m/k) of λ in the coupling well (ps)."""
@@ -88,52 +85,15 @@ class EABF:
 
     def check_time_step(self, dt: float) -> None:
         """λ's oscillation must span ≥ 10 time steps, or its integration is unstable."""
-        from pointatlas.errors import ConfigError
-
-        if self.period_of_lambda() < 10 * dt:
-            raise ConfigError(
-                f"the extended variable oscillates with period {self.period_of_lambda():.3g} "
-                f"ps, under 10 time steps of {dt:g} ps: its integration would blow up. Raise "
-                f"its mass to at least {self.k * (10 * dt / (2 * np.pi)) ** 2:.3g} or lower "
-                f"the coupling.")
+        self.grid.check_time_step(dt)
 
     def step(self, xi: float, rng: np.random.Generator, dt: float) -> None:
         """Accumulate at (ξ, λ), then advance λ by one BAOAB step of Langevin dynamics."""
-        f = self.coupling(xi)
-        bl = self.bin(self.lam)
-        if bl >= 0:
-            self.f_sum[bl] += f
-            self.f_count[bl] += 1
-        bz = self.bin(xi)
-        if bz >= 0:
-            self.z_count[bz] += 1
-            self.z_lam_sum[bz] += wrap(self.lam - xi, self.period)
-        total = f + self.bias(bl)
-        self.vel += 0.5 * dt * total / self.mass
-        self._drift(0.5 * dt)
-        c = np.exp(-self.friction * dt)
-        self.vel = c * self.vel + np.sqrt((1 - c * c) * self.kT / self.mass) * rng.normal()
-        self._drift(0.5 * dt)
-        # the second half kick uses the force at the new λ (the same ξ: x moves next)
-        f2 = self.k * wrap(xi - self.lam, self.period)
-        self.vel += 0.5 * dt * (f2 + self.bias(self.bin(self.lam))) / self.mass
-
-    def _drift(self, h: float) -> None:
-        """λ += h v, folded (periodic) or reflected at the walls (mirror, reverse v)."""
-        self.lam += h * self.vel
-        if self.period is not None:
-            self.lam = self.lower + (self.lam - self.lower) % self.period
-        elif self.lam < self.lower or self.lam > self.upper:
-            self.lam = 2 * self.lower - self.lam if self.lam < self.lower else \
-                2 * self.upper - self.lam
-            self.vel = -self.vel
+        self.grid.step([xi], rng, dt)
 
     def bias(self, b: int) -> float:
         """Minus the ramped running mean of F_λ in bin b (0 outside the range)."""
-        if b < 0 or self.f_count[b] == 0:
-            return 0.0
-        n = self.f_count[b]
-        return -min(1.0, n / self.full_samples) * self.f_sum[b] / n
+        return float(self.grid.bias(b)[0])
 
 
 def czar_gradient(z_count, z_lam_sum, width, k, kT, periodic, min_count=20):

@@ -10,7 +10,7 @@ import numpy as np
 import xarray as xr
 
 from .errors import InputError
-from .results import RESULTS_NAME, open_run
+from .results import RESULTS_NAME, open_run, write_netcdf_atomic
 
 
 def parse_override(text: str) -> tuple[str, str]:
@@ -64,22 +64,15 @@ def _fresh_sweep_file(sweep_dir: Path, dirs: list[Path]) -> Path | None:
 
 def write_sweep(path: str | os.PathLike, sweep_id: str | None = None) -> Path | None:
     """Write the combined Dataset of a finished multirun to ``<sweep dir>/sweep.nc`` (to a
-    temporary name, then renamed), so it is not assembled again on each read. None when the
-    directory holds no finished job."""
+    temporary name, then renamed; large variables chunked as a run's results), so it is not
+    assembled again on each read. None when the directory holds no finished job."""
     sweep_dir = Path(path)
     if not run_dirs(sweep_dir):
         return None
     ds = _assemble(sweep_dir)
     if sweep_id:
         ds.attrs["sweep_id"] = sweep_id
-    out = sweep_dir / SWEEP_FILE
-    tmp = sweep_dir / f".{SWEEP_FILE}.{os.getpid()}.tmp"
-    try:
-        ds.to_netcdf(tmp)
-        os.replace(tmp, out)
-    finally:
-        tmp.unlink(missing_ok=True)
-    return out
+    return write_netcdf_atomic(ds, sweep_dir / SWEEP_FILE)
 
 
 def open_sweep(path: str | os.PathLike) -> xr.Dataset:

@@ -156,6 +156,10 @@ class DaskExecutor:
             raise
         return self._client
 
+    def n_threads(self) -> int:
+        """Threads of all the workers (the parts a map is cut in are a multiple of it)."""
+        return max(1, sum(self.client().nthreads().values()))
+
     def start(self) -> None:
         """Connect now (the run calls this first: an unreachable scheduler or workers of
         another version stop the run before any work)."""
@@ -217,7 +221,7 @@ class DaskExecutor:
             return []
         client = self.client()
         labels = list(labels) if labels is not None else [f"item {i}" for i in range(len(items))]
-        threads = max(1, sum(client.nthreads().values()))
+        threads = self.n_threads()
         costs = np.ones(len(items)) if costs is None else np.asarray(costs, dtype=np.float64)
         batches = balanced_batches(costs, min(len(items), self.tasks_per_thread * threads))
         shared_future = self._scatter_shared(shared, shared_key)

@@ -133,7 +133,8 @@ class Assembler:
         U = self.layout.as_blocks(U)
         q = self.q
         ranges = balanced_ranges(np.diff(q.indptr).astype(float), self._n_parts(q.n_points))
-        parts = self._run(residual_part, [(U, a0, a1) for a0, a1 in ranges], "residual")
+        parts = self._run(residual_part, [(U, a0, a1) for a0, a1 in split_for_cluster(ranges)],
+                          "residual")
         dens = np.concatenate([d for _, d in parts]) if len(parts) > 1 else parts[0][1]
         f = parts[0][0]
         for extra, _ in parts[1:]:
@@ -177,7 +178,7 @@ class Assembler:
         U = self.layout.as_blocks(U)
         plan = self.q.assembly_plan()
         B, N = self.layout.block, self.layout.n_nodes
-        bounds = [(int(b0), int(b1)) for b0, b1 in plan.thread_bounds]
+        bounds = split_for_cluster([(int(b0), int(b1)) for b0, b1 in plan.thread_bounds])
         items = [(U, b0, b1) for b0, b1 in bounds]
         if current_executor().distributed:
             parts = self._run(tangent_part, items, "tangent")
@@ -214,6 +215,25 @@ class Assembler:
                                plan.cols, np.int64(L.n_nodes), data)
                 c0 = c1
         return data
+
+
+def split_for_cluster(ranges: list[tuple[int, int]]) -> list[tuple[int, int]]:
+    """The ranges of this process's threads, each cut in k contiguous pieces when the run's
+    distributed executor has k times more threads (k = 1 otherwise, and with as many worker
+    threads as local ones: the parts, and so the sums, are those of a local run; with more,
+    the sums are regrouped and differ from a local run's at round-off)."""
+    executor = current_executor()
+    threads = getattr(executor, "n_threads", None)
+    if not executor.distributed or threads is None:
+        return ranges
+    k = -(-int(threads()) // max(1, len(ranges)))
+    if k <= 1:
+        return ranges
+    out = []
+    for a, b in ranges:
+        cuts = np.linspace(a, b, k + 1).astype(np.int64)
+        out += [(int(s), int(e)) for s, e in zip(cuts[:-1], cuts[1:]) if e > s]
+    return out
 
 
 def residual_part(assembler: Assembler, item):

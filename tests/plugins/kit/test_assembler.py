@@ -109,3 +109,46 @@ def test_linear_source_is_external_work():
     _, R = de.residual(np.zeros(de.n_dofs))
     assert np.isclose(R.sum(), -patch["weights"].sum(), rtol=1e-10)
     assert Assembler  # the public entry point
+
+
+class ManyThreadsInProcess:
+    """A 'distributed' executor of ``threads`` threads that runs the tasks here (pickled and
+    unpickled, as a cluster would receive them)."""
+
+    distributed = True
+
+    def __init__(self, threads):
+        self.threads, self.calls = threads, []
+
+    def n_threads(self):
+        return self.threads
+
+    def map(self, fn, items, *, shared=None, shared_key=None, desc="", labels=None, costs=None):
+        import pickle
+
+        shared = pickle.loads(pickle.dumps(shared))
+        self.calls.append((desc, len(items)))
+        return [fn(shared, item) for item in items]
+
+    def close(self):
+        pass
+
+
+@pytest.mark.parametrize("threads", [1, 7])
+def test_parts_on_a_cluster_sum_to_the_local_tangent_and_residual(threads):
+    """The tangent and residual cut into a cluster's parts (7 threads: each local range in
+    pieces) are the local ones: bit for bit with as many parts, to round-off with more."""
+    from pointatlas.executor import using_executor
+
+    de = DiscreteEnergy((PHI, DISP), [Coupled()], curved_patch(24))
+    U = np.random.default_rng(2).normal(scale=0.1, size=de.n_dofs)
+    K0, (W0, R0) = de.assembler.tangent(U), de.assembler.residual(U)
+    ex = ManyThreadsInProcess(threads)
+    with using_executor(ex):
+        K1, (W1, R1) = de.assembler.tangent(U), de.assembler.residual(U)
+    assert [d for d, _ in ex.calls] == ["tangent assembly", "residual assembly"]
+    if threads > 1:
+        assert all(n > 2 for _, n in ex.calls), ex.calls
+    scale = abs(K0).max()
+    assert abs(K1 - K0).max() <= 1e-14 * scale
+    assert np.max(np.abs(R1 - R0)) <= 1e-14 * np.max(np.abs(R0)) and W1 == pytest.approx(W0, rel=1e-14)

@@ -101,7 +101,8 @@ def figures(atlas) -> np.ndarray:
 
 
 def test_a_worker_killed_mid_run_changes_nothing():
-    """kill -9 of a worker while the charts are computed: Dask re-runs its tasks (the nanny
+    """kill -9 of a worker while the charts or the quadrature are computed: Dask re-runs its
+    tasks (the nanny
     restarts it), the atlas is the one of a run that lost no worker."""
     P = ellipsoid(4000)
     expected = figures(make_atlas().build(P))
@@ -116,7 +117,7 @@ def test_a_worker_killed_mid_run_changes_nothing():
             deadline = time.time() + 120
             while time.time() < deadline and not killed:
                 for worker, keys in client.processing().items():
-                    if any(str(k).startswith("charts") for k in keys):
+                    if any(str(k).startswith(("charts", "quadrature")) for k in keys):
                         os.kill(pids[worker], signal.SIGKILL)
                         killed.append(worker)
                         return

@@ -175,3 +175,24 @@ def test_registry_entry_point_and_config(ax):
     assert fields == {"gamma", "tol", "n_spacing_neighbors", "newton_tol", "max_iter", "outside",
                       "hessians", "reproduction"}
     assert cls.Config().gamma == 0.8 and cls.Config().tol == 1e-10
+
+
+def test_a_pickled_basis_is_small_and_evaluates_the_same():
+    """Sent to a Dask worker, a chart's LME basis leaves its cell lists behind (rebuilt on
+    first use) and evaluates bit for bit as the original."""
+    import pickle
+
+    import pointatlas
+
+    rng = np.random.default_rng(4)
+    nodes = rng.random((400, 2))
+    lme = pointatlas.load_plugin("approximants", "lme")(gamma=0.8).fit(nodes)
+    x = 0.2 + 0.6 * rng.random((300, 2))
+    before = lme.evaluate(x, order=2)
+    blob = pickle.dumps(lme)
+    assert len(blob) < 12 * nodes.nbytes            # nodes, β, radii, tree: no cell lists
+    again = pickle.loads(blob)
+    assert "grid_" not in again.__dict__
+    after = again.evaluate(x, order=2)
+    for name in ("indptr", "indices", "values", "gradients", "hessians"):
+        assert np.array_equal(getattr(before, name), getattr(after, name)), name

@@ -20,7 +20,7 @@ from pointatlas.stores_config import stores_config
 
 from . import lme_kernels as K
 from .lme_kernel_2d import lme_kernel_2d
-from .support import SupportGrid, locality, nodal_spacing, support_radius, threads_for
+from .support import RebuildsCellLists, SupportGrid, locality, nodal_spacing, support_radius, threads_for
 from .validation import (
     LOCALITY_CONSTRAINTS,
     check_nodes,
@@ -36,7 +36,7 @@ POLYNOMIAL_DEGREE = {"quadratic": 2, "cubic": 3, "quartic": 4}
 
 
 @stores_config
-class LocalMaxEnt:
+class LocalMaxEnt(RebuildsCellLists):
     """Local max-ent basis functions on scattered nodes in any dimension d.
 
     Parameters
@@ -88,6 +88,7 @@ class LocalMaxEnt:
             "reproduction": [Options(("linear", *POLYNOMIAL_DEGREE))],
         }
 
+    _cell_list_attributes = ("grid_", "entry_beta_")
     description: ClassVar[str] = "Local max-ent basis functions (nodal locality β_a = γ/h_a²)."
 
     def fit(self, nodes) -> "LocalMaxEnt":
@@ -111,22 +112,6 @@ class LocalMaxEnt:
         self.grid_ = SupportGrid(self.nodes_, self.radius_)
         entries = getattr(self.grid_, "entries", None)
         self.entry_beta_ = None if entries is None else self.beta_[entries]
-
-    def __getstate__(self) -> dict:
-        """Pickled (sent to a Dask worker, copied) without the cell lists, which hold ~70
-        entries per node (about 1.5 kB a node, 20 times the nodes themselves): they are
-        rebuilt, identically, on first use (:meth:`__getattr__`)."""
-        state = self.__dict__.copy()
-        state.pop("grid_", None)
-        state.pop("entry_beta_", None)
-        return state
-
-    def __getattr__(self, name: str):
-        # only reached when the attribute is missing: the cell lists of an unpickled basis
-        if name in ("grid_", "entry_beta_") and "radius_" in self.__dict__:
-            self._build_grid()
-            return self.__dict__[name]
-        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
     @property
     def n_nodes(self) -> int:

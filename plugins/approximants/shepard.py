@@ -24,7 +24,7 @@ from pointatlas.constraints import validate_parameters
 from pointatlas.errors import InputError
 from pointatlas.stores_config import stores_config
 
-from .support import SupportGrid, locality, nodal_spacing, scan, support_radius
+from .support import RebuildsCellLists, SupportGrid, locality, nodal_spacing, scan, support_radius
 from .validation import (
     LOCALITY_CONSTRAINTS,
     check_nodes,
@@ -100,7 +100,7 @@ def shepard_kernel(points, visit, cell, starts, entries, entry_x, entry_r2, beta
 
 
 @stores_config
-class Shepard:
+class Shepard(RebuildsCellLists):
     """Gaussian Shepard partition of unity on scattered nodes (markers) in any dimension.
 
     Parameters
@@ -133,8 +133,12 @@ class Shepard:
         self.spacing_ = nodal_spacing(cKDTree(X), X, k)
         self.beta_ = locality(self.spacing_, float(self.gamma))
         self.radius_ = support_radius(self.beta_, float(self.tol))
-        self.grid_ = SupportGrid(X, self.radius_)
+        self._build_grid()
         return self
+
+    def _build_grid(self) -> None:
+        """The cell lists of the supports (:class:`~.support.RebuildsCellLists`)."""
+        self.grid_ = SupportGrid(self.nodes_, self.radius_)
 
     def evaluate(self, points, order: int = 0) -> BasisFunctions:
         """ψ_a at the (m, D) points, with gradients (order ≥ 1) and Hessians (order 2)."""

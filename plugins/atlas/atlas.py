@@ -274,19 +274,23 @@ class Atlas:
         nodes (integrate over the sampled surface only); ``keep_basis`` keeps the basis."""
         s = self.settings
         self.quadrature_ = []
+        from .orientation import frame_masks, orient_atlas
+
         executor = current_executor()
-        if executor.distributed:
+        frames = None
+        if executor.distributed:    # the charts' orientation frames are patch work too
             shared = {"pu": self.pu_, "n_markers": self.markers_.shape[0],
                       "order": s.quadrature_order, "tol_pu": s.tol_pu,
                       "need_second": need_second, "keep_basis": keep_basis}
             items = [(c, self.support_[k], np.flatnonzero(self.labels_ == k),
-                      None if real is None else np.asarray(real, bool)[c.node_index])
-                     for k, c in enumerate(self.charts_)]
-            self.quadrature_ = executor.map(
+                      None if real is None else np.asarray(real, bool)[c.node_index], mask)
+                     for k, (c, mask) in enumerate(zip(self.charts_, frame_masks(self)))]
+            done = executor.map(
                 patch_tasks.quadrature_task, items, shared=shared, desc="quadrature",
                 costs=[len(c.node_index) for c in self.charts_],
                 labels=[patch_tasks.patch_label(self.points_, c.node_index, k)
                         for k, c in enumerate(self.charts_)])
+            self.quadrature_, frames = [q for q, _ in done], [f for _, f in done]
         for k in ([] if executor.distributed else
                   progress(range(len(self.charts_)), total=len(self.charts_), desc="quadrature")):
             members = np.flatnonzero(self.labels_ == k)
@@ -295,9 +299,7 @@ class Atlas:
                 self.charts_[k], self.support_[k], lambda X, m=members: self._patch_values(X, m),
                 s.quadrature_order, s.tol_pu, need_second,
                 real=None if real is None else np.asarray(real, bool)[J], keep_basis=keep_basis))
-        from .orientation import orient_atlas
-
-        orient_atlas(self)  # chart_orientation_, orientation_, orientable_: one side for all
+        orient_atlas(self, frames)  # chart_orientation_, orientation_, orientable_: one side for all
         return self.quadrature_
 
     def build(self, points, markers=None, progress=lambda it, **kw: it,

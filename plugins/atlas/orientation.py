@@ -197,33 +197,44 @@ def _group_side(s: np.ndarray, sums: Optional[dict], e: Optional[np.ndarray]
     return "direction", t < 0
 
 
-def orient_atlas(atlas) -> Orientation:
+def frame_masks(atlas) -> list[np.ndarray]:
+    """Per chart, the control points whose frames decide the orientation: those where the
+    chart is used (ψ_κ > tol_pu: on the margin towards its hull an LME chart flattens to the
+    chord and its tangents turn, Paper 1 §2.3) and that another chart uses too (the others
+    decide nothing)."""
+    uses = [np.asarray(psi) > atlas.settings.tol_pu for psi in atlas.support_]
+    n_users = np.bincount(np.concatenate([c.node_index[u] for c, u in zip(atlas.charts_, uses)]),
+                          minlength=atlas.points_.shape[0])
+    return [use & (n_users[c.node_index] > 1) for c, use in zip(atlas.charts_, uses)]
+
+
+def chart_frames(chart, mask: np.ndarray) -> np.ndarray:
+    """(n_κ, C(D, d)) unit d-vectors of chart κ's own frame at its control points in
+    ``mask`` (order-1 derivatives at Ξ_κ), NaN elsewhere and where the chart is undefined."""
+    used = np.flatnonzero(mask)
+    W = np.full((len(chart.node_index), _n_minors(chart.xi_nodes.shape[1],
+                                                  chart.control_points.shape[1])), np.nan)
+    if used.size:
+        _, T, _, outside = chart.evaluate(chart.xi_nodes[used], order=1)
+        W[used] = frame_vectors(T)
+        W[used[np.asarray(outside, bool)]] = np.nan
+    return W
+
+
+def orient_atlas(atlas, frames: Optional[Sequence[np.ndarray]] = None) -> Orientation:
     """Orient a built atlas (charts and quadrature): sets ``chart_orientation_`` (L,) ±1,
     ``orientation_`` (str: 'outward', 'first_chart', the direction used as '[nx, ny, nz]',
     or 'none'), ``orientable_`` (bool) and ``orientation_report_`` (the :class:`Orientation`).
 
-    Frames at the control points come from each chart's own derivatives (order 1 at Ξ_κ),
-    at the points two or more charts use (ψ_κ > tol_pu); the quadrature sums use the chart normals at its Gauss points (hypersurfaces only).
+    Frames at the control points (:func:`chart_frames` on :func:`frame_masks`; ``frames``:
+    already computed, e.g. by the patch tasks of a distributed run); the quadrature sums use
+    the chart normals at its Gauss points (hypersurfaces only).
     """
     from .differential_geometry import unit_normal
 
     charts, quad = atlas.charts_, atlas.quadrature_
-    # only where the chart is used (ψ_κ > tol_pu): on the margin towards its hull an LME
-    # chart flattens to the chord and its tangents turn (Paper 1 §2.3); and only at points
-    # that another chart uses too (the others decide nothing)
-    uses = [np.asarray(psi) > atlas.settings.tol_pu for psi in atlas.support_]
-    n_users = np.bincount(np.concatenate([c.node_index[u] for c, u in zip(charts, uses)]),
-                          minlength=atlas.points_.shape[0])
-    frames = []
-    for ch, use in zip(charts, uses):
-        used = np.flatnonzero(use & (n_users[ch.node_index] > 1))
-        W = np.full((len(ch.node_index), _n_minors(ch.xi_nodes.shape[1],
-                                                   ch.control_points.shape[1])), np.nan)
-        if used.size:
-            _, T, _, outside = ch.evaluate(ch.xi_nodes[used], order=1)
-            W[used] = frame_vectors(T)
-            W[used[np.asarray(outside, bool)]] = np.nan
-        frames.append(W)
+    if frames is None:
+        frames = [chart_frames(c, m) for c, m in zip(charts, frame_masks(atlas))]
     d, D = charts[0].xi_nodes.shape[1], charts[0].control_points.shape[1]
     sums = None
     if D == d + 1:

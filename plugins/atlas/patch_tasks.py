@@ -13,6 +13,7 @@ import numpy as np
 
 from .chart import build_chart, chart_quadrature
 from .chart_repair import embed_control_set
+from .orientation import chart_frames
 
 
 def patch_label(points: np.ndarray, J: np.ndarray, k: int | None = None) -> str:
@@ -45,10 +46,12 @@ def patch_values(pu, n_markers: int, members: np.ndarray, X: np.ndarray) -> np.n
 
 
 def quadrature_task(shared: dict, item: tuple):
-    """The Gauss points of one chart: item = (chart, ψ_κ at its nodes, marker indices I_κ,
-    real flags of its nodes or None)."""
-    chart, support, members, real = item
+    """(Gauss points, orientation frames) of one chart: item = (chart, ψ_κ at its nodes,
+    marker indices I_κ, real flags of its nodes or None, the nodes whose frames orient the
+    atlas (:func:`.orientation.frame_masks`))."""
+    chart, support, members, real, frame_mask = item
     pu, n_markers = shared["pu"], shared["n_markers"]
-    return chart_quadrature(chart, support, lambda X: patch_values(pu, n_markers, members, X),
-                            shared["order"], shared["tol_pu"], shared["need_second"],
-                            real=real, keep_basis=shared["keep_basis"])
+    q = chart_quadrature(chart, support, lambda X: patch_values(pu, n_markers, members, X),
+                         shared["order"], shared["tol_pu"], shared["need_second"],
+                         real=real, keep_basis=shared["keep_basis"])
+    return q, chart_frames(chart, frame_mask)

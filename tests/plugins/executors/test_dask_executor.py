@@ -153,22 +153,17 @@ def test_an_unreachable_scheduler_is_one_line_with_the_fix(run_cli, tmp_path):
     assert "no Dask scheduler answers at tcp://127.0.0.1:1" in r.stderr
 
 
-def _set_version(value):
-    import pointatlas
-
-    pointatlas.__version__ = value
-    return value
-
-
 def test_workers_of_another_version_are_refused_with_both(cluster):
     client = distributed.Client(cluster)
     try:
-        client.run(_set_version, "0.0.1-other")
+        # exec of source text: the workers cannot import this test module
+        client.run(exec, "import pointatlas; pointatlas.__version__ = '0.0.1-other'")
         with pytest.raises(ConfigError, match=r"run pointatlas 0\.0\.1-other .*this run "
                                               rf"pointatlas {pointatlas.__version__}"):
             DaskExecutor(scheduler_address=cluster.scheduler_address).start()
     finally:
-        client.run(_set_version, pointatlas.__version__)
+        client.run(exec, f"import pointatlas; pointatlas.__version__ = "
+                         f"{pointatlas.__version__!r}")
         client.close()
 
 

@@ -21,7 +21,19 @@ from __future__ import annotations
 from contextlib import contextmanager
 from typing import Any, Callable, Iterator, Protocol, Sequence
 
+import numpy as np
+
 from .errors import PointatlasError
+
+
+def balanced_ranges(work: np.ndarray, n_parts: int) -> list[tuple[int, int]]:
+    """Contiguous, non-empty index ranges over len(work) items with about equal Σ work (at
+    most ``n_parts``; [(0, 0)] for no items): the parts of a map and of the kit's assembly."""
+    c = np.cumsum(work, dtype=np.float64)
+    total = c[-1] if len(c) else 0.0
+    cuts = np.searchsorted(c, total * np.arange(1, n_parts) / n_parts)
+    b = np.concatenate([[0], cuts, [len(work)]]).astype(np.int64)
+    return [(int(s), int(e)) for s, e in zip(b[:-1], b[1:]) if e > s] or [(0, 0)]
 
 
 class TaskError(PointatlasError):

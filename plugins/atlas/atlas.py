@@ -21,9 +21,9 @@ from pointatlas.executor import current_executor
 from . import differential_geometry as dg
 from . import memory_estimate as mem
 from .settings import GEOMETRY_MARKERS_PER_PATCH, AtlasSettings
-from .chart import Chart, ChartQuadrature, build_chart, chart_quadrature
+from .chart import Chart, ChartQuadrature
 from .quadrature import simplex_rule
-from .partition import embedding_defects, is_connected, partition_markers, refine_partition
+from .partition import is_connected, partition_markers, refine_partition
 from .chart_repair import (AtlasError, EmbeddingAttempt, Fresh, embed_control_set,
                            failed_patches_message, repair_embedders)
 from . import patch_tasks
@@ -60,9 +60,6 @@ class Atlas:
         agg = csr_matrix((np.ones(labels.size), (np.arange(labels.size), labels)),
                          shape=(labels.size, L))
         return (W @ agg).tocsr()
-
-    def _patch_values(self, X, members: np.ndarray) -> np.ndarray:
-        return patch_tasks.patch_values(self.pu_, self.markers_.shape[0], members, X)
 
     # -- construction ----------------------------------------------------------------
     def _control_set(self, members: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -241,26 +238,15 @@ class Atlas:
         once for the whole atlas (least_squares_scope='global', Paper 2 App. B)."""
         s = self.settings
         per_chart = s.least_squares_scope == "chart"
-        self.charts_, self.support_ = [], []
         L = int(self.labels_.max()) + 1
-        executor = current_executor()
-        if executor.distributed:
-            sets = [self._control_set(np.flatnonzero(self.labels_ == k)) for k in range(L)]
-            self.support_ = [psi for _, psi in sets]
-            shared = {"points": self.points_, "make_lme": Fresh(self.make_lme()),
-                      "least_squares_fit": s.least_squares_fit and per_chart}
-            self.charts_ = executor.map(
-                patch_tasks.chart_task, [(J, self._embedding(J)) for J, _ in sets],
-                shared=shared, desc="charts", costs=[len(J) for J, _ in sets],
-                labels=[patch_tasks.patch_label(self.points_, J, k)
-                        for k, (J, _) in enumerate(sets)])
-        for k in ([] if executor.distributed else progress(range(L), total=L, desc="charts")):
-            members = np.flatnonzero(self.labels_ == k)
-            J, psi = self._control_set(members)
-            xi = self._embedding(J)  # the embedding the chart test accepted (chart_repair)
-            self.charts_.append(build_chart(self.points_, J, None, self.make_lme,
-                                            s.least_squares_fit and per_chart, xi=xi))
-            self.support_.append(psi)
+        sets = [self._control_set(np.flatnonzero(self.labels_ == k)) for k in range(L)]
+        self.support_ = [psi for _, psi in sets]
+        shared = {"points": self.points_, "make_lme": Fresh(self.make_lme()),
+                  "least_squares_fit": s.least_squares_fit and per_chart}
+        # each chart on the embedding the chart test accepted (chart_repair)
+        self.charts_ = self._map_patches(patch_tasks.chart_task,
+                                         [(J, self._embedding(J)) for J, _ in sets], shared,
+                                         "charts", [J for J, _ in sets], progress)
         if s.least_squares_fit and not per_chart:
             from .surface_fit import fit_control_points
 
@@ -272,35 +258,35 @@ class Atlas:
                          ) -> list[ChartQuadrature]:
         """Gauss points of every chart; ``real`` (N,) bool excludes triangles touching ghost
         nodes (integrate over the sampled surface only); ``keep_basis`` keeps the basis."""
-        s = self.settings
-        self.quadrature_ = []
         from .orientation import frame_masks, orient_atlas
 
-        executor = current_executor()
-        frames = None
-        if executor.distributed:    # the charts' orientation frames are patch work too
-            shared = {"pu": self.pu_, "n_markers": self.markers_.shape[0],
-                      "order": s.quadrature_order, "tol_pu": s.tol_pu,
-                      "need_second": need_second, "keep_basis": keep_basis}
-            items = [(c, self.support_[k], np.flatnonzero(self.labels_ == k),
-                      None if real is None else np.asarray(real, bool)[c.node_index], mask)
-                     for k, (c, mask) in enumerate(zip(self.charts_, frame_masks(self)))]
-            done = executor.map(
-                patch_tasks.quadrature_task, items, shared=shared, desc="quadrature",
-                costs=[len(c.node_index) for c in self.charts_],
-                labels=[patch_tasks.patch_label(self.points_, c.node_index, k)
-                        for k, c in enumerate(self.charts_)])
-            self.quadrature_, frames = [q for q, _ in done], [f for _, f in done]
-        for k in ([] if executor.distributed else
-                  progress(range(len(self.charts_)), total=len(self.charts_), desc="quadrature")):
-            members = np.flatnonzero(self.labels_ == k)
-            J = self.charts_[k].node_index
-            self.quadrature_.append(chart_quadrature(
-                self.charts_[k], self.support_[k], lambda X, m=members: self._patch_values(X, m),
-                s.quadrature_order, s.tol_pu, need_second,
-                real=None if real is None else np.asarray(real, bool)[J], keep_basis=keep_basis))
+        s = self.settings
+        shared = {"pu": self.pu_, "n_markers": self.markers_.shape[0],
+                  "order": s.quadrature_order, "tol_pu": s.tol_pu,
+                  "need_second": need_second, "keep_basis": keep_basis}
+        # the charts' orientation frames are patch work too (a distributed client then never
+        # evaluates the charts itself)
+        items = [(c, self.support_[k], np.flatnonzero(self.labels_ == k),
+                  None if real is None else np.asarray(real, bool)[c.node_index], mask)
+                 for k, (c, mask) in enumerate(zip(self.charts_, frame_masks(self)))]
+        done = self._map_patches(patch_tasks.quadrature_task, items, shared, "quadrature",
+                                 [c.node_index for c in self.charts_], progress)
+        self.quadrature_, frames = [q for q, _ in done], [f for _, f in done]
         orient_atlas(self, frames)  # chart_orientation_, orientation_, orientable_: one side for all
         return self.quadrature_
+
+    def _map_patches(self, task, items: list, shared: dict, desc: str, node_sets: list,
+                     progress) -> list:
+        """``task(shared, item)`` for every patch on the run's executor
+        (:mod:`pointatlas.executor`): in this process with ``progress`` lines, or as batched
+        tasks on a cluster; the cost of a patch is its number of control points."""
+        executor = current_executor()
+        if not executor.distributed:
+            items = progress(items, total=len(items), desc=desc)
+        return executor.map(task, items, shared=shared, desc=desc,
+                            costs=[len(J) for J in node_sets],
+                            labels=[patch_tasks.patch_label(self.points_, J, k)
+                                    for k, J in enumerate(node_sets)])
 
     def build(self, points, markers=None, progress=lambda it, **kw: it,
               real: Optional[np.ndarray] = None, keep_basis: bool = False) -> "Atlas":

@@ -29,7 +29,7 @@ import numpy as np
 
 from pointatlas.constraints import Interval, Types
 from pointatlas.errors import ConfigError, InputError, PointatlasError
-from pointatlas.executor import TaskError
+from pointatlas.executor import TaskError, balanced_ranges
 from pointatlas.stores_config import stores_config
 
 log = logging.getLogger("pointatlas.executor")
@@ -45,15 +45,6 @@ def require_distributed():
             "executor=dask needs Dask distributed, which is not installed: pip install "
             "'pointatlas[distributed]' (or use executor=local).") from None
     return distributed
-
-
-def balanced_batches(costs: np.ndarray, n_batches: int) -> list[tuple[int, int]]:
-    """Contiguous [start, stop) ranges over the items with about equal Σ cost each."""
-    c = np.cumsum(np.asarray(costs, dtype=np.float64))
-    total = c[-1] if len(c) else 0.0
-    cuts = np.searchsorted(c, total * np.arange(1, n_batches) / n_batches, side="right")
-    b = np.unique(np.concatenate([[0], np.minimum(cuts, len(c)), [len(c)]])).astype(int)
-    return [(int(s), int(e)) for s, e in zip(b[:-1], b[1:]) if e > s]
 
 
 def run_batch(fn, shared, payload):
@@ -223,7 +214,7 @@ class DaskExecutor:
         labels = list(labels) if labels is not None else [f"item {i}" for i in range(len(items))]
         threads = self.n_threads()
         costs = np.ones(len(items)) if costs is None else np.asarray(costs, dtype=np.float64)
-        batches = balanced_batches(costs, min(len(items), self.tasks_per_thread * threads))
+        batches = balanced_ranges(costs, min(len(items), self.tasks_per_thread * threads))
         shared_future = self._scatter_shared(shared, shared_key)
         payloads = client.scatter([(items[a:b], labels[a:b]) for a, b in batches], hash=False)
         if threads > 1 and len(client.nthreads()) > 1:

@@ -14,8 +14,11 @@ from dataclasses import dataclass
 
 import numba
 import numpy as np
+
 from numba import njit
 from scipy.sparse import csr_matrix
+
+from pointatlas.executor import balanced_ranges  # noqa: F401 (the assembler's parts)
 
 DEFAULT_BLOCK_CAP = 256
 
@@ -42,15 +45,6 @@ def run_threads(fn, ranges) -> list:
 
 def n_threads(n_items: int) -> int:
     return max(1, min(numba.get_num_threads(), n_items))
-
-
-def balanced_ranges(work: np.ndarray, n_parts: int) -> list[tuple[int, int]]:
-    """Contiguous index ranges over len(work) items with about equal Σ work."""
-    c = np.cumsum(work, dtype=np.float64)
-    total = c[-1] if len(c) else 0.0
-    cuts = np.searchsorted(c, total * np.arange(1, n_parts) / n_parts)
-    b = np.concatenate([[0], cuts, [len(work)]]).astype(np.int64)
-    return [(int(s), int(e)) for s, e in zip(b[:-1], b[1:]) if e > s] or [(0, 0)]
 
 
 @njit(cache=True, nogil=True)

@@ -17,7 +17,8 @@ from pointatlas.errors import ConfigError, InputError
 from pointatlas.executor import SerialExecutor, TaskError, using_executor
 from pointatlas.testing import conformance_task
 from pointatlas_atlas.atlas import Atlas, AtlasSettings
-from pointatlas_executors.dask_executor import DaskExecutor, balanced_batches
+from pointatlas.executor import balanced_ranges as balanced_batches
+from pointatlas_executors.dask_executor import DaskExecutor
 
 distributed = pytest.importorskip("distributed")
 

@@ -192,7 +192,9 @@ class SurfaceGeometry:
                         attrs={"title": f"atlas geometry of {cloud.name} ({cloud.n_points} points,"
                                         f" {ctx.plugin_name('embedder')} charts)",
                                "mean_curvature_convention": "H = κ1 + κ2"})
-        warning = atlas.refinement_warning()  # failed patches kept by allow_failed_patches
+        warning = "; ".join(w for w in (atlas.refinement_warning(),  # allow_failed_patches
+                                        gauss_bonnet_warning(atlas, float(ds[
+                                            "total_gaussian_curvature"]))) if w)
         if warning:
             ds.attrs["warnings"] = warning
         for key in ("area", "willmore_energy", "total_gaussian_curvature"):
@@ -238,3 +240,26 @@ def _embedder_codes(atlas) -> tuple[np.ndarray, dict]:
 
 def _units(key: str) -> str:
     return {"area": "length^2", "willmore_energy": "1", "total_gaussian_curvature": "1"}[key]
+
+
+#: |∫K/2π − χ| above which a closed surface's curvatures are flagged (χ the nearest even
+#: integer): 0.1 is ∫K off by 0.2π, 5 % of a sphere's 4π (converged clouds: below 1e-3)
+MAX_EULER_DEFECT = 0.1
+
+
+def gauss_bonnet_warning(atlas, total_k: float) -> str | None:
+    """The atlas's own check of its curvatures on a closed surface (oriented 'outward':
+    it encloses a volume): Gauss–Bonnet, ∫K dA = 2π χ with χ = 2 − 2g an even integer ≤ 2.
+    A total curvature far from every such value (e.g. ∫K/2π = 0.10 on a pyvista ellipsoid
+    with poles crowded by its parametrisation) means the charts' second derivatives are
+    wrong somewhere: the warning marks the results as not trustworthy."""
+    if "outward" not in str(getattr(atlas, "orientation_", "")):
+        return None
+    chi = total_k / (2 * np.pi)
+    nearest = min(2.0, 2.0 * np.round(chi / 2.0))
+    if abs(chi - nearest) <= MAX_EULER_DEFECT:
+        return None
+    return (f"Gauss–Bonnet fails on this closed surface: ∫K dA / 2π = {chi:.3g}, not an even "
+            f"integer ≤ 2 (nearest {nearest:g}): the curvatures (Willmore energy, ∫K, H, K) are "
+            "not trustworthy. Try a denser or more even sample, or other chart settings "
+            "(atlas.chart_reproduction, atlas.markers_per_patch).")

@@ -86,3 +86,23 @@ def test_bad_chart_hessians_rejected(tmp_path):
     with pytest.raises(ConfigError,
                        match="chart_hessians='diffuse' is invalid.*'exact'.*'consistent'"):
         SurfaceGeometry(**ctx.config["study"]).run(ctx)
+
+
+@pytest.mark.parametrize("orientation,total_k,flagged", [
+    ("outward", 4 * np.pi * (1 + 2e-3), False),    # a sphere, converged
+    ("outward", 0.0, False),                         # a torus
+    ("outward", -4 * np.pi, False),                  # genus 2
+    ("outward", 0.657032, True),   # measured: pyvista ParametricEllipsoid(1.5, 1, 0.7), quartic
+    ("outward", 4 * np.pi * 1.2, True),              # 20 % off on a sphere
+    ("first_chart", 0.657032, False),                # open surface: no Gauss–Bonnet check
+])
+def test_gauss_bonnet_flags_a_closed_surface_whose_curvature_is_wrong(orientation, total_k,
+                                                                       flagged):
+    from types import SimpleNamespace
+
+    from pointatlas_studies.surface_geometry import gauss_bonnet_warning
+
+    w = gauss_bonnet_warning(SimpleNamespace(orientation_=orientation), total_k)
+    assert (w is not None) == flagged
+    if flagged:
+        assert w.startswith("Gauss–Bonnet fails on this closed surface") and "\n" not in w

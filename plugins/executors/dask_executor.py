@@ -6,11 +6,12 @@ then sends the items of a map (the atlas's patches, the assembler's point blocks
 
 - the ``shared`` data (the point array, the partition of unity) is scattered to every worker
   once (``broadcast``), the items in ``tasks_per_thread`` × (worker threads) contiguous
-  batches of about equal cost, each scattered and held on two workers: no task carries its
-  data in the task graph (no "large graph" warning), and a worker lost mid-run loses no
-  data;
-- a worker that dies (``kill -9``) has its tasks re-run by Dask elsewhere: the functions are
-  pure, so the results are the same;
+  batches of about equal cost, each scattered and copied to a second worker: no task
+  carries its data in the task graph (no "large graph" warning);
+- a worker that dies (``kill -9``) has its tasks re-run by Dask elsewhere; batches whose
+  only copy of scattered data it held (the scheduler's active memory manager drops extra
+  replicas) are scattered and submitted again. The functions are pure, so the results are
+  the same;
 - a task that raises becomes one :class:`~pointatlas.executor.TaskError` naming the item
   (``patch 17``) and the worker with its message;
 - progress (tasks done of all, rate, ETA) is logged as the tasks finish.
@@ -34,6 +35,8 @@ from pointatlas.stores_config import stores_config
 
 log = logging.getLogger("pointatlas.executor")
 _TOKENS = itertools.count()
+#: how many times the batches whose scattered data a lost worker held are sent again
+MAX_RESUBMISSIONS = 3
 
 
 def require_distributed():
@@ -202,7 +205,13 @@ class DaskExecutor:
 
     def map(self, fn, items, *, shared=None, shared_key=None, desc="tasks", labels=None,
             costs=None) -> list:
-        """``[fn(shared, item) for item in items]`` as batched tasks on the cluster."""
+        """``[fn(shared, item) for item in items]`` as batched tasks on the cluster.
+
+        Scattered data lives on workers: Dask re-runs the tasks of a lost worker, but not
+        data whose only copy it held (the scheduler's active memory manager drops the extra
+        replicas). Batches cancelled so are scattered and submitted again, up to
+        :data:`MAX_RESUBMISSIONS` times; the functions are pure, so the results do not
+        change."""
         from distributed import as_completed
 
         from pointatlas.progress import Progress
@@ -215,21 +224,50 @@ class DaskExecutor:
         threads = self.n_threads()
         costs = np.ones(len(items)) if costs is None else np.asarray(costs, dtype=np.float64)
         batches = balanced_ranges(costs, min(len(items), self.tasks_per_thread * threads))
-        shared_future = self._scatter_shared(shared, shared_key)
-        payloads = client.scatter([(items[a:b], labels[a:b]) for a, b in batches], hash=False)
-        if threads > 1 and len(client.nthreads()) > 1:
-            client.replicate(payloads, n=2)      # a lost worker loses no batch
         token = next(_TOKENS)
-        futures = [client.submit(run_batch, fn, shared_future, p, pure=False,
-                                 retries=self.retries, key=f"{desc}-{token}-{i}")
-                   for i, p in enumerate(payloads)]
-        index = {f.key: i for i, f in enumerate(futures)}
-        results: list = [None] * len(futures)
-        bar = Progress(total=len(futures), desc=f"{desc} on dask ({len(items)} items in "
-                                                 f"{len(futures)} tasks, {threads} threads)",
+        results: list = [None] * len(batches)
+        pending = list(range(len(batches)))
+        bar = Progress(total=len(batches), desc=f"{desc} on dask ({len(items)} items in "
+                                                f"{len(batches)} tasks, {threads} threads)",
                        logger=log)
         try:
+            for round_ in range(MAX_RESUBMISSIONS + 1):
+                pending = self._run_batches(client, fn, shared, shared_key, items, labels,
+                                            batches, pending, results, f"{desc}-{token}-"
+                                            f"{round_}", desc, bar, as_completed)
+                if not pending:
+                    break
+                log.warning("%s: a lost worker held the only copy of the data of %d tasks: "
+                            "sending them again", desc, len(pending))
+                self._drop_shared(shared_key)
+            else:
+                raise TaskError(f"{desc}: workers kept dying with the data of {len(pending)} "
+                                f"tasks ({MAX_RESUBMISSIONS} resubmissions); check the "
+                                "workers' memory and logs")
+        finally:
+            bar.close()
+        return [r for part in results for r in part]
+
+    def _run_batches(self, client, fn, shared, shared_key, items, labels, batches, pending,
+                     results, prefix, desc, bar, as_completed) -> list:
+        """Submit the ``pending`` batches and gather them into ``results``; returns those
+        cancelled because their scattered data was lost."""
+        shared_future = self._scatter_shared(shared, shared_key)
+        payloads = client.scatter([(items[batches[i][0]:batches[i][1]],
+                                    labels[batches[i][0]:batches[i][1]]) for i in pending],
+                                  hash=False)
+        if len(client.nthreads()) > 1:
+            client.replicate(payloads, n=2)      # fewer lost batches when a worker dies
+        futures = [client.submit(run_batch, fn, shared_future, p, pure=False,
+                                 retries=self.retries, key=f"{prefix}-{i}")
+                   for i, p in zip(pending, payloads)]
+        index = {f.key: i for i, f in zip(pending, futures)}
+        lost = []
+        try:
             for future in as_completed(futures):
+                if future.status == "cancelled":
+                    lost.append(index[future.key])
+                    continue
                 if future.status == "error":
                     exc = future.exception()
                     if isinstance(exc, PointatlasError):
@@ -239,9 +277,14 @@ class DaskExecutor:
                 results[index[future.key]] = future.result()
                 bar.update(1)
         finally:
-            bar.close()
             client.cancel([f for f in futures if not f.done()])
             if shared_key is None:
                 client.cancel([shared_future])
             client.cancel(payloads)
-        return [r for part in results for r in part]
+        return sorted(lost)
+
+    def _drop_shared(self, key) -> None:
+        """Forget the cached scattered ``shared`` of ``key`` (its data may be lost)."""
+        cache = getattr(self, "_shared", None)
+        if cache is not None and key in cache:
+            self._client.cancel([cache.pop(key)])

@@ -133,6 +133,34 @@ def test_a_worker_killed_mid_run_changes_nothing():
     np.testing.assert_array_equal(got, expected)
 
 
+def test_batches_whose_scattered_data_was_lost_are_sent_again(cluster, monkeypatch, caplog):
+    """A worker that dies with the only copy of a batch's scattered data (Dask cannot re-run
+    those tasks: they are cancelled) costs a resubmission, not the run: here the first round
+    reports every other batch lost, and the map still returns every result, in order."""
+    ex = DaskExecutor(scheduler_address=cluster.scheduler_address, tasks_per_thread=4)
+    real = DaskExecutor._run_batches
+    rounds = []
+
+    def losing(self, client, fn, shared, shared_key, items, labels, batches, pending, *rest):
+        rounds.append(list(pending))
+        if len(rounds) > 1:
+            return real(self, client, fn, shared, shared_key, items, labels, batches,
+                        pending, *rest)
+        kept = pending[::2]
+        real(self, client, fn, shared, shared_key, items, labels, batches, kept, *rest)
+        return pending[1::2]
+
+    monkeypatch.setattr(DaskExecutor, "_run_batches", losing)
+    try:
+        with caplog.at_level("WARNING", logger="pointatlas.executor"):
+            got = ex.map(conformance_task, list(range(3, 43)), shared=3, desc="demo")
+    finally:
+        ex.close()
+    assert got == [conformance_task(3, i) for i in range(3, 43)]
+    assert len(rounds) == 2 and rounds[1] == rounds[0][1::2]
+    assert "only copy of the data of" in caplog.text
+
+
 @settings(max_examples=50, deadline=None)
 @given(st.lists(st.floats(0.01, 100), min_size=1, max_size=60), st.integers(1, 20))
 def test_balanced_batches_cover_the_items_in_order(costs, n):

@@ -148,6 +148,7 @@ class LocalMaxEnt(RebuildsCellLists):
         """Replace, in place on the rows of the points where LME exists, the Hessians
         (hessians='consistent') or values, gradients and Hessians (reproduction other than
         'linear') by those of the weighted polynomial fit (:mod:`.weighted_polynomial_fit`)."""
+        from . import weighted_polynomial_fit as wpf
         from .weighted_polynomial_fit import consistent_hessians, polynomial_fit_basis
 
         d = self.nodes_.shape[1]
@@ -172,7 +173,7 @@ class LocalMaxEnt(RebuildsCellLists):
                                                      axis=1))
             polynomial_fit_basis(args[0], args[1], sub[0], sub[1], self.nodes_, args[2],
                                  self.h_ref_, 1e6, POLYNOMIAL_DEGREE[self.reproduction], sub[2],
-                                 w)
+                                 w, wpf.MAX_LEBESGUE)
         else:
             consistent_hessians(args[0], args[1], sub[0], self.nodes_, args[2], self.h_ref_,
                                 1e6, sub[2])

@@ -151,9 +151,11 @@ def test_polynomial_fit_basis_reproduces_its_degree(ax, d, reproduction, gamma, 
     row = np.repeat(np.arange(len(x)), np.diff(plain.indptr))
     prior = np.exp(-lme.beta_[plain.indices]
                    * np.sum((X[plain.indices] - x[row]) ** 2, axis=1))   # the fit's weights
-    polynomial_fit_basis(plain.indptr, plain.indices, plain.values.copy(), probe[0],
-                         lme.nodes_, x, lme.h_ref_, 1e6, degree, probe[1], prior)
-    fitted = np.isfinite(probe[1][plain.indptr[:-1]]).all(axis=(1, 2))
+    used = polynomial_fit_basis(plain.indptr, plain.indices, plain.values.copy(), probe[0],
+                                lme.nodes_, x, lme.h_ref_, 1e6, degree, probe[1], prior)
+    written = np.isfinite(probe[1][plain.indptr[:-1]]).all(axis=(1, 2))
+    assert np.array_equal(written, used > 0)
+    fitted = used == degree          # rows whose fit was not lowered to a smaller degree
     assert fitted.any()
     f, grad, hess = random_polynomial(d, degree, rng)
     v, g, H = applied(B, f(X), len(x))

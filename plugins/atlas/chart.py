@@ -25,6 +25,7 @@ from scipy.sparse.linalg import splu
 from scipy.spatial import Delaunay
 
 from . import differential_geometry as dg
+from .chart_fidelity import chart_departure
 from .quadrature import map_rule_to_simplices, simplex_rule
 
 
@@ -149,6 +150,7 @@ class ChartQuadrature:
     n_candidates: int         # Gauss points before dropping those with ψ_κ ≈ 0
     lost_pu: float            # largest ψ_κ at a Gauss point dropped because LME is undefined
     basis: object = None      # BasisFunctions at the kept points (global node ids), if asked
+    departure: dict = None    # chart_fidelity.chart_departure: where φ_κ leaves its samples
 
 
 @dataclass
@@ -160,6 +162,7 @@ class Chart:
     control_points: np.ndarray   # (n, D) P_a (refitted if least squares was used)
     approximant: object          # fitted LME on Ξ_κ
     fit_residual: float          # max |φ_κ(ξ_a) − x_a| over nodes where φ_κ exists
+    samples: np.ndarray | None = None  # (n, D) the points x_a (None: the control points)
 
     def evaluate(self, xi: np.ndarray, order: int = 2):
         """(φ, Dφ, D²φ, outside) at parametric points; rows where ``outside`` are zero."""
@@ -181,7 +184,8 @@ def build_chart(points: np.ndarray, node_index: np.ndarray, embedder, make_appro
                 Callable[[], object], least_squares_fit: bool,
                 xi: np.ndarray | None = None) -> Chart:
     """Embed the control points J_κ (unless their embedding ``xi`` is given) and build the
-    LME chart on them."""
+    LME chart on them; with ``least_squares_fit`` its control points are fitted so that it
+    interpolates the points (Paper 2 App. B)."""
     P = points[node_index]
     if xi is None:
         xi = embedder.fit_transform(P)
@@ -194,7 +198,7 @@ def build_chart(points: np.ndarray, node_index: np.ndarray, embedder, make_appro
     X, _, _ = chart_derivatives(basis, C, 0)
     ok = np.ones(len(P), bool) if basis.outside is None else ~basis.outside
     resid = float(np.max(np.linalg.norm(X - P, axis=1)[ok], initial=0.0))
-    return Chart(node_index, xi, C, lme, resid)
+    return Chart(node_index, xi, C, lme, resid, samples=P)
 
 
 #: charts with at most this many control points solve the interpolation system densely
@@ -272,6 +276,7 @@ def chart_quadrature(chart: Chart, support_at_nodes: np.ndarray, patch_pu: Calla
     simplices = simplices[keep]
     rule = simplex_rule(d, order)
     xg, wg = map_rule_to_simplices(xi[simplices], rule)
+    tri = np.repeat(np.arange(len(simplices)), rule.n_points)   # simplex-major points
     n_candidates = len(wg)
     basis = chart.approximant.evaluate(xg, order=2 if need_second else 1)
     X, T, S = chart_derivatives(basis, chart.control_points, 2 if need_second else 1)
@@ -284,7 +289,7 @@ def chart_quadrature(chart: Chart, support_at_nodes: np.ndarray, patch_pu: Calla
         lost = float(np.max(patch_pu(chart.control_points[j]), initial=0.0))
     inside = ~outside
     if outside.any():
-        xg, wg, X, T = xg[inside], wg[inside], X[inside], T[inside]
+        xg, wg, X, T, tri = xg[inside], wg[inside], X[inside], T[inside], tri[inside]
         S = None if S is None else S[inside]
     psi = patch_pu(X)
     J = area_element(T)
@@ -292,7 +297,9 @@ def chart_quadrature(chart: Chart, support_at_nodes: np.ndarray, patch_pu: Calla
     kept = None
     if keep_basis:
         kept = basis.take(np.flatnonzero(inside)[use]).renumbered(chart.node_index)
+    samples = chart.control_points if chart.samples is None else chart.samples
+    departure = chart_departure(xi, samples, simplices[tri[use]], T[use], (wg * J * psi)[use])
     return ChartQuadrature(
         xi=xg[use], weights=(wg * J * psi)[use], positions=X[use], tangents=T[use],
         second=None if S is None else S[use], pu=psi[use], area_element=J[use],
-        n_candidates=n_candidates, lost_pu=lost, basis=kept)
+        n_candidates=n_candidates, lost_pu=lost, basis=kept, departure=departure)

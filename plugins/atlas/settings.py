@@ -41,7 +41,8 @@ class AtlasSettings:
     gamma_pu: float = 4.0
     tol_pu: float = 1e-6
     quadrature_order: int = 6
-    least_squares_fit: bool = True
+    least_squares_fit: bool = True        # linear charts interpolate the points (Paper 2
+    #                                       App. B); polynomial charts never (Atlas.interpolates)
     least_squares_scope: str = "chart"    # 'chart': each chart interpolates its control
     #                                       points; 'global': one set of control points for
     #                                       all charts, the blend fits the points (Paper 2

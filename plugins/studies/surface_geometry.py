@@ -154,6 +154,7 @@ class SurfaceGeometry:
                 "long_name": f"chart contribution ∫ψ_κ(·) of the {long_name.split(' ∫')[0]}",
                 "units": _units(key)})
         sizes = np.bincount(atlas.labels_, minlength=L)
+        trusted = atlas.accepted_ & atlas.charts_faithful()   # chart test and chart_fidelity
         data.update({
             "n_points": ((), cloud.n_points, {**one, "long_name": "number of points"}),
             "n_markers": ((), atlas.markers_.shape[0], {**one, "long_name": "number of markers"}),
@@ -167,19 +168,26 @@ class SurfaceGeometry:
                 "units": "length"}),
             "max_lost_pu": ((), max(q.lost_pu for q in atlas.quadrature_), {**one, "long_name": (
                 "largest ψ_κ near a Gauss point dropped outside the LME hull (should be ~0)")}),
-            "n_unaccepted_patches": ((), int((~atlas.accepted_).sum()), {**one, "long_name": (
+            "n_unaccepted_patches": ((), int((~trusted).sum()), {**one, "long_name": (
                 "patches whose chart still fails the fold/stress/distortion test after repair "
-                "(only with allow_failed_patches; else the run is refused)")}),
-            "unaccepted_weight_fraction": ((), float(per_patch["area"][~atlas.accepted_].sum()
+                "or departs from its points (only with allow_failed_patches; else the run is "
+                "refused)")}),
+            "unaccepted_weight_fraction": ((), float(per_patch["area"][~trusted].sum()
                                                      / per_patch["area"].sum()),
                                            {**one, "long_name": (
-                "fraction of the quadrature weight (area) on patches that fail the chart test")}),
+                "fraction of the quadrature weight (area) on patches that fail the chart test "
+                "or depart from their points")}),
             "patch_embedder": (("patch",), *_embedder_codes(atlas)),
             "patch_split_depth": (("patch",), atlas.patch_depth_, {**one, "long_name": (
                 "times the patch was bisected after the initial METIS partition (repair)")}),
             "patch_markers": (("patch",), sizes, {**one, "long_name": "markers in the patch"}),
-            "patch_accepted": (("patch",), atlas.accepted_.astype(np.int8), {**one, "long_name": (
-                "1 if the patch's chart passed the fold/stress/distortion test")}),
+            "patch_accepted": (("patch",), trusted.astype(np.int8), {**one, "long_name": (
+                "1 if the patch's chart passed the fold/stress/distortion test and stays on "
+                "its points")}),
+            "patch_departed_weight": (("patch",), np.array(
+                [(q.departure or {}).get("departed_weight", 0.0) for q in atlas.quadrature_]),
+                {**one, "long_name": ("fraction of the chart's quadrature weight where it "
+                                      "departs from the triangles of its samples")}),
             "patch_control_points": (("patch",), np.array([len(c.node_index) for c in
                                                           atlas.charts_]),
                                      {**one, "long_name": "control points of the chart"}),

@@ -92,7 +92,7 @@ def test_bad_chart_hessians_rejected(tmp_path):
     ("outward", 4 * np.pi * (1 + 2e-3), False),    # a sphere, converged
     ("outward", 0.0, False),                         # a torus
     ("outward", -4 * np.pi, False),                  # genus 2
-    ("outward", 0.657032, True),   # measured: pyvista ParametricEllipsoid(1.5, 1, 0.7), quartic
+    ("outward", 0.657032, True),   # measured before chart_fidelity.py: a pyvista ellipsoid grid
     ("outward", 4 * np.pi * 1.2, True),              # 20 % off on a sphere
     ("first_chart", 0.657032, False),                # open surface: no Gauss–Bonnet check
 ])

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import itertools
 import json
+import logging
 import os
 from pathlib import Path
 
@@ -51,6 +52,7 @@ def swept_parameters(overrides: list[list[str]]) -> list[str]:
 
 
 SWEEP_FILE = "sweep.nc"
+log = logging.getLogger(__name__)
 
 
 def _fresh_sweep_file(sweep_dir: Path, dirs: list[Path]) -> Path | None:
@@ -75,9 +77,15 @@ def write_sweep(path: str | os.PathLike, sweep_id: str | None = None) -> Path | 
     return write_netcdf_atomic(ds, sweep_dir / SWEEP_FILE)
 
 
-def open_sweep(path: str | os.PathLike) -> xr.Dataset:
+def open_sweep(path: str | os.PathLike, lazy: bool = False) -> xr.Dataset:
     """One Dataset for a multirun directory: its ``sweep.nc`` when the sweep finished (and no
-    job was rerun since), else assembled from the jobs' results.
+    job was rerun since, and it reads), else assembled from the jobs' results.
+
+    By default everything is read into memory and the files are closed. With ``lazy=True``
+    (needs dask) nothing is read yet: variables are dask arrays in the files' own chunks
+    (see :func:`~pointatlas.results.open_run`), the files stay open until ``ds.close()`` (or
+    the end of a ``with open_sweep(..., lazy=True) as ds:`` block), and values are read as
+    they are computed, so a sweep larger than memory can be reduced run by run.
 
     When the runs form a full grid over the swept override keys, those keys are dimensions
     named without dots (``source.n_points`` -> ``source_n_points``, the key in the
@@ -95,10 +103,15 @@ def open_sweep(path: str | os.PathLike) -> xr.Dataset:
         )
     fresh = _fresh_sweep_file(sweep_dir, dirs)
     if fresh is not None:
-        ds = xr.open_dataset(fresh)
-        ds.attrs["sweep_dir"] = str(sweep_dir)
-        return ds
-    return _assemble(sweep_dir)
+        try:
+            ds = open_run(fresh, lazy=lazy)
+        except InputError as exc:   # damaged: the jobs' results are the source of truth
+            log.warning("%s could not be read (%s); reading the %d jobs instead", fresh,
+                        type(exc).__name__, len(dirs))
+        else:
+            ds.attrs["sweep_dir"] = str(sweep_dir)
+            return ds
+    return _assemble(sweep_dir, lazy)
 
 
 def dim_name(key: str, taken=()) -> str:
@@ -108,9 +121,16 @@ def dim_name(key: str, taken=()) -> str:
     return name + "_swept" if name in taken else name
 
 
-def _assemble(sweep_dir: Path) -> xr.Dataset:
+def _assemble(sweep_dir: Path, lazy: bool = False) -> xr.Dataset:
     dirs = run_dirs(sweep_dir)
-    runs = [open_run(d) for d in dirs]
+    runs = []
+    try:
+        for d in dirs:
+            runs.append(open_run(d, lazy=lazy))
+    except Exception:
+        for ds in runs:
+            ds.close()
+        raise
     overrides = [json.loads(ds.attrs.get("overrides", "[]")) for ds in runs]
     keys = swept_parameters(overrides)
     values = [[typed(dict(map(parse_override, ov)).get(k, "")) for k in keys] for ov in overrides]
@@ -146,6 +166,8 @@ def _assemble(sweep_dir: Path) -> xr.Dataset:
                                                                  ds.attrs.items()}}
                                          for d, ds in zip(dirs, runs)])
     out.attrs["sweep_dir"] = str(sweep_dir)
+    if lazy:   # the runs' files stay open under the dask arrays until the sweep is closed
+        out.set_close(lambda: [ds.close() for ds in runs])
     return out
 
 
@@ -158,14 +180,17 @@ def _indexed(ds: xr.Dataset) -> xr.Dataset:
 
 def _restore_integers(out: xr.Dataset, runs: list[xr.Dataset]) -> None:
     """Variables that are integers in every run stay integers when stacking needed no
-    padding (no missing value)."""
+    padding: the variable is in every run with the sizes it has in ``out`` along its own
+    dims (an outer join that added a missing value would have enlarged one). Decided from
+    the sizes alone, so a lazy sweep reads nothing."""
     for name in list(out.data_vars):
-        kinds = {ds[name].dtype for ds in runs if name in ds}
-        if len(kinds) == 1 and np.issubdtype(next(iter(kinds)), np.integer) and len(
-                [ds for ds in runs if name in ds]) == len(runs):
-            values = out[name].values
-            if np.issubdtype(values.dtype, np.floating) and np.all(np.isfinite(values)):
-                out[name] = out[name].astype(next(iter(kinds)))
+        have = [ds[name] for ds in runs if name in ds]
+        kinds = {v.dtype for v in have}
+        if len(have) != len(runs) or len(kinds) != 1 or not np.issubdtype(
+                next(iter(kinds)), np.integer) or out[name].dtype == next(iter(kinds)):
+            continue
+        if all(out.sizes[d] == n for v in have for d, n in v.sizes.items()):
+            out[name] = out[name].astype(next(iter(kinds)))
 
 
 def _plain(value):

@@ -298,7 +298,9 @@ class Atlas:
         done = self._map_patches(patch_tasks.quadrature_task, items, shared, "quadrature",
                                  [c.node_index for c in self.charts_], progress)
         self.quadrature_, frames = [q for q, _ in done], [f for _, f in done]
-        if not self.charts_faithful().all() and not s.allow_failed_patches:
+        # a smooth chart across a crease leaves its samples' triangles by construction: with
+        # atlas.allow_creases (the user accepted a creased cloud) it is flagged, not refused
+        if not self.charts_faithful().all() and not (s.allow_failed_patches or s.allow_creases):
             raise AtlasError(self._departed_charts_message(refuse=True))
         orient_atlas(self, frames)  # chart_orientation_, orientation_, orientable_: one side for all
         return self.quadrature_

@@ -59,6 +59,7 @@ class AtlasSettings:
     #                                       refuses the atlas, True keeps them, flagged
     allow_creases: bool = False           # crease points of the cloud check (a physics):
     #                                       False refuses, True runs on, flagged in warnings
+    #                                       (charts departing from their points too)
     orientation: Optional[List[float]] = None  # the side an open surface's normals face
     #                                       (n·e > 0 on average; orientation.py); None: the
     #                                       first chart's. Closed surfaces: always outward

@@ -114,7 +114,8 @@ class SurfacePDE:
                              *errors(p.field_at_quadrature(self.field), self.exact)))
                 ctx.log.info("refinement N = %d: L2 %.3e, H1 %.3e", *rows[-1][:1], *rows[-1][2:])
             R = np.array(rows, float)
-            ds = ds.assign_coords(refinement=("refinement", np.arange(len(R))))
+            ds = ds.assign_coords(refinement=("refinement", np.arange(len(R)), {
+                "long_name": "refinement level (index into study.refinement)", "units": "1"}))
             ds["refinement_points"] = (("refinement",), R[:, 0].astype(int),
                                        {"long_name": "points of the cloud", "units": "1"})
             ds["refinement_dof"] = (("refinement",), R[:, 1].astype(int),

@@ -70,9 +70,9 @@ def quartic_atlas(**kw):
 
 def test_quartic_charts_on_grid_lines_stay_on_their_points():
     """With the Lebesgue guard of the fit (wider weights, then a lower degree, where the
-    weights sit on one line) no chart departs and Gauss–Bonnet holds to 3 % (measured 2.8 %;
-    the area is 0.35 % short of the exact 13.98426, the charts' 3h margin being one meridian
-    gap there). Before the guard: ∫K dA / 4π = 0.05 at 6 164 points of this grid."""
+    weights sit on one line) no chart departs and Gauss–Bonnet holds to 3 % (measured −2.1 %,
+    area −0.27 % against the exact 13.98426, with the 5h margin of polynomial charts; −2.85 %
+    and −0.35 % with 3h). Before the guard: ∫K dA / 4π = 0.05 at 6 164 points of this grid."""
     P = grid_ellipsoid()
     atlas = quartic_atlas().build(P)
     assert atlas.charts_faithful().all() and atlas.refinement_warning() is None

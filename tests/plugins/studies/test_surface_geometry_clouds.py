@@ -119,7 +119,7 @@ def test_pyvista_sphere_is_refused_or_right(tmp_path):
     """sphere.ply (422 uneven points), issue 16's bar: the default command refuses it in one
     line naming the fix (its spacing varies by 41 %); the fix it names (quartic charts) gives
     ∫K within 2 % of 4π and the Willmore energy within 5 % of 16π, every chart accepted
-    (measured: −1.4 % and −1.1 %)."""
+    (measured: −1.03 % and −0.71 %)."""
     with pytest.raises(InputError, match="chart_reproduction=quartic") as info:
         run_file(tmp_path / "default", pyvista_file("sphere.ply"))
     assert "\n" not in str(info.value)
@@ -151,8 +151,8 @@ def test_a_parametric_ellipsoid_grid_with_quartic_charts(tmp_path):
     chart_margin 5, gamma_pu 2). Quartic charts used to end 'completed' with ∫K dA = 0.657
     and a Willmore energy of 313 536; measured now: ∫K −0.26 %, Willmore −0.18 %, area
     −0.06 % against the exact 4π, 62.95380 and 13.98425 (the last two by a 1 000 × 2 000
-    midpoint rule in the test's own parametrisation), 27 s. With the default 3h margin
-    the area falls 0.57 % short (the margin is about one meridian gap)."""
+    midpoint rule in the test's own parametrisation), 27 s. (With the 3h margin that
+    polynomial charts had before, the area fell 0.57 % short: about one meridian gap.)"""
     pv = pytest.importorskip("pyvista")
     m = pv.ParametricEllipsoid(1.5, 1.0, 0.7, u_res=80, v_res=80, w_res=80)
     P = np.unique(np.asarray(m.points, dtype=np.float64).round(6), axis=0)

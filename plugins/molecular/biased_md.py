@@ -10,6 +10,7 @@ outside the parametrised region, ill-conditioned, …) gets no bias force and is
 """
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 
@@ -88,10 +89,13 @@ def run_eabf(mol, cv, cv_atoms, eabf, n_steps: int, seed: int, *, platform="Refe
     prev = None
     refused, first_refused, newton_max = 0, -1, 0
     x_prev = None
+    atoms = [int(a) for a in cv_atoms]
+    zero = [0.0, 0.0, 0.0]
+    pos = np.empty((system.getNumParticles(), 3))
     t0 = time.perf_counter()
     for s in range(n_steps):
-        pos = positions_of(ctx)
-        if not np.all(np.isfinite(pos)):
+        positions_of(ctx, pos)
+        if not math.isfinite(float(pos.sum())):
             raise PointatlasError(
                 f"biased MD blew up at step {s} (non-finite positions): lower the coupling "
                 f"k or the time step, or raise the extended variable's mass.")
@@ -104,15 +108,16 @@ def run_eabf(mol, cv, cv_atoms, eabf, n_steps: int, seed: int, *, platform="Refe
             newton_max = max(newton_max, v.steps)
             xi = comp(v.xi)
             c = eabf.coupling(xi)
-            fvec = -c * v.gradient[0] if scalar else -np.tensordot(c, v.gradient[:d], 1)
-            for i in range(len(cv_atoms)):
-                force.setParticleParameters(i, int(cv_atoms[i]), fvec[i].tolist())
+            g = v.gradient
+            fvec = -c * g[0] if scalar else -(c @ g[:d].reshape(d, -1)).reshape(-1, 3)
+            for i, row in enumerate(fvec.tolist()):
+                force.setParticleParameters(i, atoms[i], row)
             eabf.step(xi, rng, dt)
         else:
             refused += 1
             first_refused = s if first_refused < 0 else first_refused
-            for i in range(len(cv_atoms)):
-                force.setParticleParameters(i, int(cv_atoms[i]), [0.0, 0.0, 0.0])
+            for i in range(len(atoms)):
+                force.setParticleParameters(i, atoms[i], zero)
         force.updateParametersInContext(ctx)
         if s % save_every == 0 and s // save_every < n_save:
             j = s // save_every

@@ -21,12 +21,7 @@ import numpy as np
 
 from pointatlas.errors import ConfigError
 
-
-def wrap(d, period):
-    """d folded into [−period/2, period/2) per axis where ``period`` is not NaN."""
-    d = np.asarray(d, dtype=float)
-    p = np.asarray(period, dtype=float)
-    return np.where(np.isnan(p), d, (d + 0.5 * p) % np.where(np.isnan(p), 1.0, p) - 0.5 * p)
+from .eabf_kernel import coupling, eabf_step, flat_bin
 
 
 class EABFGrid:
@@ -55,24 +50,18 @@ class EABFGrid:
                               f"lies outside the eABF range; widen the range or start "
                               f"elsewhere.")
         self.vel = np.zeros(d)
+        self._n_bins = np.array(self.n_bins, dtype=np.int64)
+        self._region_rows = (np.zeros((0, d + 1)) if self.region is None
+                             else np.ascontiguousarray(self.region))
         B = int(np.prod(self.n_bins))
         self.f_sum, self.f_count = np.zeros((B, d)), np.zeros(B, dtype=np.int64)
         self.z_count, self.z_lam_sum = np.zeros(B, dtype=np.int64), np.zeros((B, d))
 
     # -- geometry ---------------------------------------------------------------------------
-    def _fold(self, v):
-        p = self.periods
-        per = ~np.isnan(p)
-        v = np.array(v, dtype=float)
-        v[per] = self.lower[per] + (v[per] - self.lower[per]) % p[per]
-        return v
-
     def bin(self, v) -> int:
         """Flat (C-order) bin of a CV value; −1 outside the box."""
-        i = np.floor((self._fold(v) - self.lower) / self.width).astype(int)
-        if np.any(i < 0) or np.any(i >= np.array(self.n_bins)):
-            return -1
-        return int(np.ravel_multi_index(tuple(i), self.n_bins))
+        v = np.atleast_1d(np.asarray(v, dtype=float))
+        return int(flat_bin(v, self.lower, self.width, self._n_bins, self.periods))
 
     def centres(self, axis: int) -> np.ndarray:
         return self.lower[axis] + self.width[axis] * (np.arange(self.n_bins[axis]) + 0.5)
@@ -88,7 +77,10 @@ class EABFGrid:
     # -- dynamics ---------------------------------------------------------------------------
     def coupling(self, xi) -> np.ndarray:
         """k (ξ − λ) per axis: the force on λ and, times −∂ξ_a/∂x, on the atoms."""
-        return self.k * wrap(np.asarray(xi, dtype=float) - self.lam, self.periods)
+        f = np.empty(self.dim)
+        coupling(f, np.atleast_1d(np.asarray(xi, dtype=float)), self.lam.astype(float), self.k,
+                 self.periods)
+        return f
 
     def check_time_step(self, dt: float) -> None:
         """λ's oscillation 2π √(m/k) must span ≥ 10 time steps on every axis."""
@@ -108,44 +100,18 @@ class EABFGrid:
         n = self.f_count[b]
         return -min(1.0, n / self.full_samples) * self.f_sum[b] / n
 
-    def _drift(self, h):
-        """λ += h v, reflected at the box (non-periodic axes) and at the region."""
-        old = self.lam.copy()
-        self.lam = self.lam + h * self.vel
-        for a in range(self.dim):
-            if not np.isnan(self.periods[a]):
-                continue
-            if self.lam[a] < self.lower[a]:
-                self.lam[a], self.vel[a] = 2 * self.lower[a] - self.lam[a], -self.vel[a]
-            elif self.lam[a] > self.upper[a]:
-                self.lam[a], self.vel[a] = 2 * self.upper[a] - self.lam[a], -self.vel[a]
-        if self.region is not None:
-            viol = self.region[:, :-1] @ self.lam + self.region[:, -1]
-            if np.any(viol > 0):
-                n = self.region[int(np.argmax(viol)), :-1]
-                self.lam = old
-                self.vel = self.vel - 2 * (self.vel @ n) * n
-        self.lam = self._fold(self.lam)
-
     def step(self, xi, rng: np.random.Generator, dt: float) -> None:
-        """Accumulate at (ξ, λ), then advance λ by one BAOAB step of Langevin dynamics."""
-        xi = np.asarray(xi, dtype=float)
-        f = self.coupling(xi)
-        bl = self.bin(self.lam)
-        if bl >= 0:
-            self.f_sum[bl] += f
-            self.f_count[bl] += 1
-        bz = self.bin(xi)
-        if bz >= 0:
-            self.z_count[bz] += 1
-            self.z_lam_sum[bz] += wrap(self.lam - xi, self.periods)
-        self.vel += 0.5 * dt * (f + self.bias(bl)) / self.mass
-        self._drift(0.5 * dt)
-        c = np.exp(-self.friction * dt)
-        self.vel = c * self.vel + np.sqrt((1 - c * c) * self.kT / self.mass) * \
-            rng.normal(size=self.dim)
-        self._drift(0.5 * dt)
-        self.vel += 0.5 * dt * (self.coupling(xi) + self.bias(self.bin(self.lam))) / self.mass
+        """Accumulate at (ξ, λ), then advance λ by one BAOAB step of Langevin dynamics
+        (:func:`.eabf_kernel.eabf_step`; one normal draw per axis from ``rng``)."""
+        xi = np.ascontiguousarray(xi, dtype=float)
+        noise = rng.normal(size=self.dim)
+        if self.lam.dtype != np.float64 or self.vel.dtype != np.float64:
+            self.lam, self.vel = self.lam.astype(float), self.vel.astype(float)
+        region = self._region_rows
+        eabf_step(self.lam, self.vel, xi, noise, float(dt), self.lower, self.upper, self.width,
+                  self._n_bins, self.periods, region, self.k, self.mass, self.kT,
+                  self.friction, self.full_samples, self.f_sum, self.f_count, self.z_count,
+                  self.z_lam_sum)
 
     # -- estimator --------------------------------------------------------------------------
     def free_energy(self, min_count: int = 20):

@@ -133,8 +133,8 @@ class SandCV:
     def predict(previous: CVValue, x_previous, x) -> np.ndarray:
         """A warm start for x from the value at a nearby x_previous (the previous MD step):
         ξ_prev + ∂ξ/∂x (x − x_prev), first-order accurate (the previous ξ alone is zeroth)."""
-        return previous.xi + np.tensordot(previous.gradient, np.asarray(x) - x_previous,
-                                          axes=([1, 2], [0, 1]))
+        g = previous.gradient
+        return previous.xi + g.reshape(g.shape[0], -1) @ (np.asarray(x) - x_previous).ravel()
 
     def __call__(self, x, xi_start=None, tol: float | None = None) -> CVValue:
         """ξ(x) of the CV atoms' positions x (n, 3) in nm, warm-started from ``xi_start``;

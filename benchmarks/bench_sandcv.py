@@ -9,19 +9,22 @@ Measures, on this machine:
   positions out, CV, force parameters in, every step) and on φ, steps/s and ns/day, and the
   ratio to plain MD on the same platform.
 
-Run: ``MPLBACKEND=Agg python benchmarks/bench_sandcv.py`` (about 3 minutes).
+Run: ``MPLBACKEND=Agg python benchmarks/bench_sandcv.py`` (about 30 s).
 
-Measured here (2-core machine, 2026-12-05, four runs; the CPU platform's rates vary 2–4×
-from run to run on these shared cores):
-  plain MD: Reference 43 000–57 000 steps/s (7 500–9 800 ns/day), CPU 1 960–7 500 steps/s
-  SandCV evaluation: median 76–111 µs (90th percentile 101–124 µs); Newton steps of 200
-    configurations: 2 (20), 3 (174), 4 (5), 19 (1)
-  eABF on SandCV ξ₁: Reference 1 840–2 730 steps/s (320–470 ns/day, 3–5 % of plain MD);
-    CPU 97–624 steps/s (2–18 %)
-  eABF on φ: Reference 2 900–4 400 steps/s (5–10 %); CPU 610–2 100 steps/s (11–57 %)
+Measured here (2-core machine, quiet, 2026-12-06, after the eABF step became a numba kernel
+and the loop lost its numpy/unit overheads; the run takes ~30 s):
+  plain MD: Reference 84 177 steps/s (14 546 ns/day), CPU 2 891 steps/s (500 ns/day)
+  SandCV evaluation: median 37.3 µs (90th percentile 44.6 µs); Newton steps of 200
+    configurations: 2 (168), 3 (30), 4 (1), 18 (1)
+  eABF on SandCV ξ₁: Reference 7 940 steps/s (1 372 ns/day, 9 % of plain MD);
+    CPU 1 736 steps/s (300 ns/day, 60 % of plain MD)
+  eABF on φ: Reference 8 652 steps/s (10 %); CPU 1 802 steps/s (62 %)
   exploration, 200 ps of eABF on ξ₁: no sample with 0 < φ < 120° (nor in training)
-The ≥ 50 % of plain MD target is missed: per step, positions out (20–50 µs), CV (~100 µs),
-λ and 10 × 3 force parameters in (~35 µs) cost more than a Reference step (~18 µs).
+The ≥ 50 % of plain MD target is met on the CPU platform and missed on Reference, whose step
+(~12 µs for 22 atoms) is shorter than one Python round trip: per step, positions out (3 µs),
+SandCV (~40 µs), the eABF step (~7 µs), 10 force-parameter updates (~25 µs), loop (~15 µs).
+Reference stays the faster platform for biased alanine dipeptide (4.6× CPU's biased rate).
+Before (2026-12-05, loaded machine): Reference 1 840–2 730 steps/s (3–5 %), CPU 97–624 (2–18 %).
 """
 from __future__ import annotations
 

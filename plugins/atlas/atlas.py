@@ -24,6 +24,7 @@ from .settings import GEOMETRY_MARKERS_PER_PATCH, AtlasSettings
 from .chart import Chart, ChartQuadrature
 from .quadrature import simplex_rule
 from .partition import is_connected, partition_markers, refine_partition
+from .chart_coverage import MAX_EDGE_PU, atlas_edge_message, check_chart_edges
 from .chart_fidelity import departed_charts_message, departs
 from .chart_repair import (AtlasError, EmbeddingAttempt, Fresh, embed_control_set,
                            failed_patches_message, repair_embedders)
@@ -211,19 +212,9 @@ class Atlas:
 
     def _check_memory(self, n_points: int, n_markers: int, ambient_dim: int,
                       keep_basis: bool, extra_bytes: int = 0, extra_what: str = "") -> None:
-        """Refuse, before any work, an atlas (with ``extra_bytes`` of what is computed on it,
-        e.g. a physics' tangent) that cannot fit in memory (one line, with fix)."""
-        needed = self.estimated_bytes(n_points, n_markers, ambient_dim, self.chart_dim_,
-                                      keep_basis) + int(extra_bytes)
-        available, _ = mem.available_memory_bytes()
-        # the estimate is linear in N; the suggested size leaves 10 % of the memory free
-        fitting = max(1, int(n_points * min(1.0, available / max(needed, 1)) * 0.9))
-        mem.check_memory(
-            needed, f"an atlas of {n_points} points in R^{ambient_dim} (charts of dimension "
-                    f"{self.chart_dim_}, quadrature order {self.settings.quadrature_order})"
-                    + (f" with {extra_what}" if extra_what else ""),
-            f"Use fewer points (e.g. source.n_points={fitting}, memory grows in proportion), a "
-            "lower study.quadrature_order, or a machine with more memory.")
+        """Refuse, before any work, an atlas that cannot fit in memory (one line, with fix)."""
+        mem.check_atlas_memory(self, n_points, n_markers, ambient_dim, keep_basis,
+                               extra_bytes, extra_what)
 
     def refinement_warning(self) -> Optional[str]:
         """Why the atlas may be wrong, if patches still fail the chart test after the repair
@@ -233,12 +224,19 @@ class Atlas:
             kept.append(self._failed_patches_message(refuse=False))
         if hasattr(self, "quadrature_") and not self.charts_faithful().all():
             kept.append(self._departed_charts_message(refuse=False))
+        if hasattr(self, "edge_pu_") and not self.charts_covered().all():
+            kept.append(atlas_edge_message(self, refuse=False))
         return "; ".join(kept) or None
 
     def charts_faithful(self) -> np.ndarray:
         """(L,) bool: the chart stays on its points at its Gauss points
         (:mod:`.chart_fidelity`; after :meth:`build_quadrature`)."""
         return np.array([not departs(q.departure or {}) for q in self.quadrature_], bool)
+
+    def charts_covered(self) -> np.ndarray:
+        """(L,) bool: ψ_κ stays off the rim of the chart's domain (:mod:`.chart_coverage`;
+        after :meth:`build_quadrature`)."""
+        return self.edge_pu_ <= MAX_EDGE_PU
 
     def _departed_charts_message(self, refuse: bool) -> str:
         return departed_charts_message(
@@ -302,6 +300,7 @@ class Atlas:
         # atlas.allow_creases (the user accepted a creased cloud) it is flagged, not refused
         if not self.charts_faithful().all() and not (s.allow_failed_patches or s.allow_creases):
             raise AtlasError(self._departed_charts_message(refuse=True))
+        check_chart_edges(self, real, refuse=not s.allow_failed_patches)  # ψ_κ off the rims
         orient_atlas(self, frames)  # chart_orientation_, orientation_, orientable_: one side for all
         return self.quadrature_
 

@@ -185,3 +185,20 @@ def _cgroup_free() -> int | None:
         return max(int(limit) - int((base / "memory.current").read_text().strip()), 0)
     except (OSError, ValueError, IndexError):
         return None
+
+
+def check_atlas_memory(atlas, n_points: int, n_markers: int, ambient_dim: int,
+                       keep_basis: bool, extra_bytes: int = 0, extra_what: str = "") -> None:
+    """Refuse, before any work, an atlas (with ``extra_bytes`` of what is computed on it,
+    e.g. a physics' tangent) that cannot fit in memory (one line, with fix)."""
+    needed = atlas.estimated_bytes(n_points, n_markers, ambient_dim, atlas.chart_dim_,
+                                   keep_basis) + int(extra_bytes)
+    available, _ = available_memory_bytes()
+    # the estimate is linear in N; the suggested size leaves 10 % of the memory free
+    fitting = max(1, int(n_points * min(1.0, available / max(needed, 1)) * 0.9))
+    check_memory(
+        needed, f"an atlas of {n_points} points in R^{ambient_dim} (charts of dimension "
+                f"{atlas.chart_dim_}, quadrature order {atlas.settings.quadrature_order})"
+                + (f" with {extra_what}" if extra_what else ""),
+        f"Use fewer points (e.g. source.n_points={fitting}, memory grows in proportion), a "
+        "lower study.quadrature_order, or a machine with more memory.")

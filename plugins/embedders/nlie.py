@@ -157,6 +157,25 @@ def _nlie_optimize(Y0, pi, pj, g, w, alpha, tol, max_iter, lbfgs_tol, lbfgs_max_
     return out.x.reshape(n, d), info
 
 
+def separate_coincident(Y, pi, pj, seed: int = 0) -> np.ndarray:
+    """Y (n, d) with every point that coincides with one of its stress partners (pairs pi,
+    pj) moved by 1e-6 of the embedding's extent in a seeded random direction. The stress term
+    (|x_ij|/|q_ij| − 1)² is infinite at q_ij = 0, and an Isomap seed maps two points with equal
+    geodesic distances to every landmark onto one (a sphere cap sampled along meridians did:
+    a ZeroDivisionError inside the stress kernel)."""
+    Y = np.array(Y, dtype=np.float64)
+    scale = float(np.max(np.ptp(Y, axis=0))) if len(Y) else 1.0
+    scale = scale if scale > 0 else 1.0
+    rng = np.random.default_rng(int(seed))
+    for _ in range(5):
+        bad = np.sum((Y[pi] - Y[pj]) ** 2, axis=1) <= (1e-12 * scale) ** 2
+        if not bad.any():
+            break
+        moved = np.unique(pj[bad])
+        Y[moved] += 1e-6 * scale * rng.standard_normal((len(moved), Y.shape[1]))
+    return Y
+
+
 @dataclass
 class NLIEConfig:
     n_components: int = 2             # below the ambient dimension (checked in fit)
@@ -245,6 +264,7 @@ class NLIE(EmbedderBase):
         del idx, dist                          # keep only the pairs during the optimisation
         Y0 = landmark_isomap_embedding(X, d, self.n_neighbors, self.radius,
                                        n_landmarks=n_land, seed=self.random_state, graph=G)
+        Y0 = separate_coincident(Y0, pi, pj, self.random_state)
         self.embedding_seed_ = Y0
         Y, info = nlie_optimize(Y0, pi, pj, g, w, alpha, tol=self.tol, max_iter=self.max_iter,
                                 lbfgs_tol=self.lbfgs_tol, lbfgs_max_iter=self.lbfgs_max_iter,

@@ -70,13 +70,18 @@ def check_chart_edges(atlas, real: np.ndarray | None, refuse: bool) -> None:
     """Sets ``atlas.edge_pu_`` and ``atlas.edge_where_``; raises AtlasError if a chart's rim
     carries weight and ``refuse``. The cloud's boundary is found by
     :func:`.boundary.boundary_mask` for surfaces in R³ (else only the rim test applies)."""
+    from pointatlas.errors import PointatlasError
+
     from .boundary import boundary_mask
     from .chart_repair import AtlasError
 
     P = atlas.points_
     on_edge = None
     if P.shape[1] == 3 and atlas.chart_dim_ == 2 and len(P) > 12:
-        on_edge = boundary_mask(P, 12)
+        try:
+            on_edge = boundary_mask(P, 12)
+        except PointatlasError:      # no tangent planes to find an edge in: rims only
+            on_edge = None
     atlas.edge_pu_, atlas.edge_where_ = pu_at_chart_edges(
         [c.node_index for c in atlas.charts_], [c.xi_nodes for c in atlas.charts_],
         atlas.support_, len(P), real, on_edge)

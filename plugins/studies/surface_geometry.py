@@ -154,7 +154,8 @@ class SurfaceGeometry:
                 "long_name": f"chart contribution ∫ψ_κ(·) of the {long_name.split(' ∫')[0]}",
                 "units": _units(key)})
         sizes = np.bincount(atlas.labels_, minlength=L)
-        trusted = atlas.accepted_ & atlas.charts_faithful()   # chart test and chart_fidelity
+        # chart test, chart_fidelity, and ψ_κ off the chart's rim (chart_coverage)
+        trusted = atlas.accepted_ & atlas.charts_faithful() & atlas.charts_covered()
         data.update({
             "n_points": ((), cloud.n_points, {**one, "long_name": "number of points"}),
             "n_markers": ((), atlas.markers_.shape[0], {**one, "long_name": "number of markers"}),
@@ -169,14 +170,14 @@ class SurfaceGeometry:
             "max_lost_pu": ((), max(q.lost_pu for q in atlas.quadrature_), {**one, "long_name": (
                 "largest ψ_κ near a Gauss point dropped outside the LME hull (should be ~0)")}),
             "n_unaccepted_patches": ((), int((~trusted).sum()), {**one, "long_name": (
-                "patches whose chart still fails the fold/stress/distortion test after repair "
-                "or departs from its points (only with allow_failed_patches; else the run is "
-                "refused)")}),
+                "patches whose chart still fails the fold/stress/distortion test after repair, "
+                "departs from its points or carries partition-of-unity weight on its rim (only "
+                "with allow_failed_patches; else the run is refused)")}),
             "unaccepted_weight_fraction": ((), float(per_patch["area"][~trusted].sum()
                                                      / per_patch["area"].sum()),
                                            {**one, "long_name": (
-                "fraction of the quadrature weight (area) on patches that fail the chart test "
-                "or depart from their points")}),
+                "fraction of the quadrature weight (area) on patches that fail the chart test, "
+                "depart from their points or carry weight on their rim")}),
             "patch_embedder": (("patch",), *_embedder_codes(atlas)),
             "patch_split_depth": (("patch",), atlas.patch_depth_, {**one, "long_name": (
                 "times the patch was bisected after the initial METIS partition (repair)")}),
@@ -184,6 +185,9 @@ class SurfaceGeometry:
             "patch_accepted": (("patch",), trusted.astype(np.int8), {**one, "long_name": (
                 "1 if the patch's chart passed the fold/stress/distortion test and stays on "
                 "its points")}),
+            "patch_rim_pu": (("patch",), atlas.edge_pu_, {**one, "long_name": (
+                "largest ψ_κ at a rim (hull) vertex of the chart's parameters inside another "
+                "chart (above 0.01 the chart's rim carries weight)")}),
             "patch_departed_weight": (("patch",), np.array(
                 [(q.departure or {}).get("departed_weight", 0.0) for q in atlas.quadrature_]),
                 {**one, "long_name": ("fraction of the chart's quadrature weight where it "

@@ -45,6 +45,22 @@ def test_repaired_patches_are_recorded(tmp_path, torus_file):
         assert "long_name" in ds[v].attrs and "units" in ds[v].attrs
     assert float(ds["area"]) == pytest.approx(4 * np.pi**2 * R * r, rel=1e-3)
     assert abs(float(ds["total_gaussian_curvature"])) < 1e-2 * 4 * np.pi
+    assert float(ds["patch_rim_pu"].max()) <= 0.01 and ds["patch_rim_pu"].attrs["units"] == "1"
+
+
+def test_a_chart_rim_carrying_weight_is_counted_and_flagged(tmp_path):
+    """pyvista's ParametricEllipsoid grid with quartic charts and a 3h margin: ψ = 1 reaches
+    a chart's rim (refused by default; flagged and counted with allow_failed_patches)."""
+    pv = pytest.importorskip("pyvista")
+    m = pv.ParametricEllipsoid(1.5, 1.0, 0.7, u_res=60, v_res=60, w_res=60)
+    path = tmp_path / "ellipsoid_grid.npz"
+    np.savez(path, points=np.unique(np.asarray(m.points, dtype=np.float64).round(9), axis=0))
+    ds = run(tmp_path / "run", path, markers_per_patch=150, chart_reproduction="quartic",
+             chart_margin=3.0, allow_failed_patches=True)
+    rim = ds["patch_rim_pu"].values
+    assert rim.max() > 0.01
+    assert int(ds["n_unaccepted_patches"]) >= int((rim > 0.01).sum()) >= 1
+    assert "rim of their domain" in ds.attrs["warnings"]
 
 
 def test_failed_patches_refused_or_flagged(tmp_path, torus_file):

@@ -46,7 +46,8 @@ def pu_at_chart_edges(node_sets: list[np.ndarray], xis: list[np.ndarray],
     chart whose domain is not convex there, so "a rim vertex of every chart" alone does not
     find it).
     """
-    rims = [np.asarray(J)[hull_vertices(xi)] for J, xi in zip(node_sets, xis)]
+    hulls = [hull_vertices(xi) for xi in xis]           # positions in J of each rim
+    rims = [np.asarray(J)[h] for J, h in zip(node_sets, hulls)]
     inner = np.zeros(n_points, dtype=bool)     # inside the hull of at least one chart
     for J, rim in zip(node_sets, rims):
         is_rim = np.zeros(n_points, dtype=bool)
@@ -57,9 +58,8 @@ def pu_at_chart_edges(node_sets: list[np.ndarray], xis: list[np.ndarray],
     if boundary is not None:
         inner &= ~np.asarray(boundary, dtype=bool)
     edge, where = np.zeros(len(node_sets)), np.full(len(node_sets), -1, dtype=np.int64)
-    for k, (J, xi, psi) in enumerate(zip(node_sets, xis, support)):
-        v = hull_vertices(xi)
-        v = v[inner[np.asarray(J)[v]]]
+    for k, (J, psi, h, rim) in enumerate(zip(node_sets, support, hulls, rims)):
+        v = h[inner[rim]]                               # the rim's vertices inside some chart
         if v.size:
             j = int(np.argmax(psi[v]))
             edge[k], where[k] = float(psi[v][j]), int(np.asarray(J)[v][j])

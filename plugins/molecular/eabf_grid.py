@@ -78,8 +78,7 @@ class EABFGrid:
     def coupling(self, xi) -> np.ndarray:
         """k (ξ − λ) per axis: the force on λ and, times −∂ξ_a/∂x, on the atoms."""
         f = np.empty(self.dim)
-        coupling(f, np.atleast_1d(np.asarray(xi, dtype=float)), self.lam.astype(float), self.k,
-                 self.periods)
+        coupling(f, np.atleast_1d(np.asarray(xi, dtype=float)), self.lam, self.k, self.periods)
         return f
 
     def check_time_step(self, dt: float) -> None:

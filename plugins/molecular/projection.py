@@ -201,40 +201,25 @@ def project(z, xi, nodes, beta, r2, P, hull, lme_tol, lme_max_iter, tol, max_ite
         predicted = 0.0  # decrease of φ the quadratic model promises for the full step
         for i in range(d):
             predicted -= 0.5 * F[i] * step[i]
-        if predicted <= 1e-12 * phi:
-            # the round-off floor: φ (a sum of squares of differences X − z that cancel to
-            # ~1e-14 relative) can no longer tell a better ξ from a worse one, so no line
-            # search; the full Newton step is the most accurate ξ there is (quadratic
-            # convergence), and is taken unless it leaves the region. Discarding it instead
-            # left ξ 1e-10 off, and finite differences of ξ 2e-5 off its gradient.
-            for i in range(d):
-                trial[i] = xi[i] + step[i]
-            phit = _state(z, trial, nodes, beta, r2, P, hull, lme_tol, lme_max_iter, w, Xt,
-                          DXt, D2Xt, Ft, Ht)
-            if np.isfinite(phit):
-                X, Xt = Xt, X
-                DX, DXt = DXt, DX
-                D2X, D2Xt = D2Xt, D2X
-                H, Ht = Ht, H
-                F, Ft = Ft, F
-                xi[:] = trial
-                phi = phit
-                it += 1
-            converged = True
-            break
+        # the round-off floor: φ (a sum of squares of differences X − z that cancel to ~1e-14
+        # relative) can no longer tell a better ξ from a worse one, so no line search; the
+        # full Newton step is the most accurate ξ there is (quadratic convergence), and is
+        # taken unless it leaves the region. Discarding it instead left ξ 1e-10 off, and
+        # finite differences of ξ 2e-5 off its gradient.
+        floor = predicted <= 1e-12 * phi
         t = 1.0
         accepted = False
-        for _ in range(MAX_HALVINGS):
+        for _ in range(1 if floor else MAX_HALVINGS):
             for i in range(d):
                 trial[i] = xi[i] + t * step[i]
             phit = _state(z, trial, nodes, beta, r2, P, hull, lme_tol, lme_max_iter, w, Xt,
                           DXt, D2Xt, Ft, Ht)
-            if phit <= phi * (1.0 + 1e-14) + 1e-300:
+            if (np.isfinite(phit) if floor else phit <= phi * (1.0 + 1e-14) + 1e-300):
                 accepted = True
                 break
             t *= 0.5
         if not accepted:
-            if small:  # a step below tol that φ cannot accept: ξ is converged
+            if small or floor:  # a step φ cannot accept, below tol or its round-off: converged
                 converged = True
                 break
             return OUTSIDE, it, np.sqrt(2 * phi), 0.0
@@ -246,7 +231,7 @@ def project(z, xi, nodes, beta, r2, P, hull, lme_tol, lme_max_iter, tol, max_ite
         xi[:] = trial
         phi = phit
         it += 1
-        if small:
+        if small or floor:
             converged = True
             break
     dist = np.sqrt(2.0 * phi)

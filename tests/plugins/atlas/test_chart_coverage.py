@@ -7,10 +7,10 @@ now refused in one line naming atlas.chart_margin, or flagged."""
 import numpy as np
 import pytest
 
-import pointatlas
-from pointatlas_atlas.atlas import Atlas, AtlasSettings
 from pointatlas_atlas.chart_coverage import MAX_EDGE_PU, pu_at_chart_edges
 from pointatlas_atlas.chart_repair import AtlasError
+
+from .test_atlas import make_atlas as atlas
 
 
 def test_rim_weight_counts_only_points_inside_another_chart():
@@ -32,16 +32,6 @@ def grid_ellipsoid(res=60):
     pv = pytest.importorskip("pyvista")
     m = pv.ParametricEllipsoid(1.5, 1.0, 0.7, u_res=res, v_res=res, w_res=res)
     return np.unique(np.asarray(m.points, dtype=np.float64).round(9), axis=0)
-
-
-def atlas(**kw):
-    s = AtlasSettings(**kw)
-    return Atlas(
-        s, make_embedder=lambda: pointatlas.load_plugin("embedders", "pca")(n_components=2),
-        make_lme=lambda: pointatlas.load_plugin("approximants", "lme")(
-            gamma=s.gamma_lme, tol=s.tol_lme, outside="flag"),
-        make_pu=lambda: pointatlas.load_plugin("approximants", "shepard")(
-            gamma=s.gamma_pu, tol=s.tol_pu, outside="flag"))
 
 
 def test_a_parametric_grid_is_refused_or_flagged_and_right_with_the_margin_named():

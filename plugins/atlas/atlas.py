@@ -166,8 +166,9 @@ class Atlas:
                              "with the same D.")
         # the chart dimension d, for d-dependent defaults (the embedders' n_components)
         self.chart_dim_ = int(getattr(self.make_embedder(), "n_components", 2))
-        self._check_memory(P.shape[0], Q.shape[0], P.shape[1], keep_basis, extra_bytes,
-                           extra_what)
+        # refuse, before any work, an atlas that cannot fit in memory (one line, with fix)
+        mem.check_atlas_memory(self, P.shape[0], Q.shape[0], P.shape[1], keep_basis,
+                               extra_bytes, extra_what)
         self.points_, self.markers_ = P, Q
         self.point_tree_ = cKDTree(P)
         self._control_sets, self._embeddings, self._margin_csr = {}, {}, None
@@ -210,12 +211,6 @@ class Atlas:
             s.max_distortion, self.repair_embedders_, self.failed_point_fraction(),
             s.max_refinement_depth, refuse=refuse)
 
-    def _check_memory(self, n_points: int, n_markers: int, ambient_dim: int,
-                      keep_basis: bool, extra_bytes: int = 0, extra_what: str = "") -> None:
-        """Refuse, before any work, an atlas that cannot fit in memory (one line, with fix)."""
-        mem.check_atlas_memory(self, n_points, n_markers, ambient_dim, keep_basis,
-                               extra_bytes, extra_what)
-
     def refinement_warning(self) -> Optional[str]:
         """Why the atlas may be wrong, if patches still fail the chart test after the repair
         of :meth:`partition` (only with ``allow_failed_patches``: else it refused); else None."""
@@ -250,9 +245,8 @@ class Atlas:
         at its nodes is a diagonally dominant smoothing, which the fit undoes. A polynomial
         chart (``chart_reproduction`` quadratic to quartic) already passes within O(σ^{k+1})
         of its points, and its basis at the nodes is not diagonally dominant: the fit
-        amplifies the noise of ξ instead (quartic charts on pyvista's ParametricEllipsoid,
-        6 164 points: control points up to 858 spacings off their points, 7 of 41 charts
-        departing from them; on pyvista's sphere.ply up to 10 spacings)."""
+        amplifies the noise of ξ instead (quartic charts on pyvista's ParametricEllipsoid:
+        control points up to 858 spacings off their points, 7 of 41 charts departing)."""
         s = self.settings
         return bool(s.least_squares_fit) and s.chart_reproduction == "linear"
 
@@ -260,42 +254,60 @@ class Atlas:
         """One chart per patch (after :meth:`partition`). With least_squares_fit, the control
         points interpolate the points chart by chart (least_squares_scope='chart') or are fitted
         once for the whole atlas (least_squares_scope='global', Paper 2 App. B)."""
-        s = self.settings
-        per_chart = s.least_squares_scope == "chart"
         L = int(self.labels_.max()) + 1
-        sets = [self._control_set(np.flatnonzero(self.labels_ == k)) for k in range(L)]
-        self.support_ = [psi for _, psi in sets]
-        shared = {"points": self.points_, "make_lme": Fresh(self.make_lme()),
-                  "least_squares_fit": self.interpolates() and per_chart}
-        # each chart on the embedding the chart test accepted (chart_repair)
-        self.charts_ = self._map_patches(patch_tasks.chart_task,
-                                         [(J, self._embedding(J)) for J, _ in sets], shared,
-                                         "charts", [J for J, _ in sets], progress)
-        if self.interpolates() and not per_chart:
+        self.support_ = [None] * L
+        self.charts_ = self._charts_of(range(L), progress)
+        if self.interpolates() and self.settings.least_squares_scope != "chart":
             from .surface_fit import fit_control_points
 
             self.control_point_fit_ = fit_control_points(self, self.points_)
         return self.charts_
+
+    def _charts_of(self, patches, progress, desc: str = "charts") -> list[Chart]:
+        """The charts of ``patches`` (indices into the labels), each on the embedding the
+        chart test accepted (chart_repair); sets their ``support_`` entries."""
+        sets = [self._control_set(np.flatnonzero(self.labels_ == k)) for k in patches]
+        for k, (_, psi) in zip(patches, sets):
+            self.support_[k] = psi
+        shared = {"points": self.points_, "make_lme": Fresh(self.make_lme()),
+                  "least_squares_fit": self.interpolates()
+                  and self.settings.least_squares_scope == "chart"}
+        return self._map_patches(patch_tasks.chart_task,
+                                 [(J, self._embedding(J)) for J, _ in sets], shared, desc,
+                                 [J for J, _ in sets], progress)
+
+    def _quadrature_of(self, patches, real, need_second: bool, keep_basis: bool, progress,
+                       desc: str = "quadrature") -> list:
+        """(Gauss points, orientation frames) of the charts ``patches``; the frames are patch
+        work too (a distributed client then never evaluates the charts itself)."""
+        from .orientation import frame_masks
+
+        s = self.settings
+        shared = {"pu": self.pu_, "n_markers": self.markers_.shape[0],
+                  "order": s.quadrature_order, "tol_pu": s.tol_pu,
+                  "need_second": need_second, "keep_basis": keep_basis}
+        masks = frame_masks(self)
+        charts = [self.charts_[k] for k in patches]
+        items = [(c, self.support_[k], np.flatnonzero(self.labels_ == k),
+                  None if real is None else np.asarray(real, bool)[c.node_index], masks[k])
+                 for k, c in zip(patches, charts)]
+        return self._map_patches(patch_tasks.quadrature_task, items, shared, desc,
+                                 [c.node_index for c in charts], progress)
 
     def build_quadrature(self, progress=lambda it, **kw: it, need_second: bool = True,
                          real: Optional[np.ndarray] = None, keep_basis: bool = False
                          ) -> list[ChartQuadrature]:
         """Gauss points of every chart; ``real`` (N,) bool excludes triangles touching ghost
         nodes (integrate over the sampled surface only); ``keep_basis`` keeps the basis."""
-        from .orientation import frame_masks, orient_atlas
+        from .departure_repair import split_departed_charts
+        from .orientation import orient_atlas
 
         s = self.settings
-        shared = {"pu": self.pu_, "n_markers": self.markers_.shape[0],
-                  "order": s.quadrature_order, "tol_pu": s.tol_pu,
-                  "need_second": need_second, "keep_basis": keep_basis}
-        # the charts' orientation frames are patch work too (a distributed client then never
-        # evaluates the charts itself)
-        items = [(c, self.support_[k], np.flatnonzero(self.labels_ == k),
-                  None if real is None else np.asarray(real, bool)[c.node_index], mask)
-                 for k, (c, mask) in enumerate(zip(self.charts_, frame_masks(self)))]
-        done = self._map_patches(patch_tasks.quadrature_task, items, shared, "quadrature",
-                                 [c.node_index for c in self.charts_], progress)
+        done = self._quadrature_of(range(len(self.charts_)), real, need_second, keep_basis,
+                                   progress)
         self.quadrature_, frames = [q for q, _ in done], [f for _, f in done]
+        # a chart that departs from its points is split and rebuilt (departure_repair)
+        split_departed_charts(self, frames, real, need_second, keep_basis, progress)
         # a smooth chart across a crease leaves its samples' triangles by construction: with
         # atlas.allow_creases (the user accepted a creased cloud) it is flagged, not refused
         if not self.charts_faithful().all() and not (s.allow_failed_patches or s.allow_creases):
@@ -353,17 +365,12 @@ class Atlas:
     def redundancy(self, definition: str = "used") -> float:
         """Quadrature redundancy: Gauss points of all charts over those of one cover of M.
 
-        definition='used' (default, kept for the studies): the Gauss points kept (ψ_κ > tol_pu)
-            over n_cover × rule size, with n_cover the simplices one chart-free triangulation
-            of the N points needs: 2N triangles for a closed surface (Euler), N segments for a
-            closed curve; for d ≥ 3 (no such count) the PU-weighted count of 'paper2'.
-        definition='paper2' (Paper 2 §1 and Fig. 1: "the ratio between the number of
-            quadrature points needed ... and the number of quadrature points if no overlap at
-            all was needed"): every Gauss point evaluated, i.e. all those of the simplices that
-            meet supp ψ_κ (including those then dropped for ψ_κ ≈ 0 or outside the LME
-            domain), over Σ_κ Σ_g ψ_κ(x_g), the Gauss points counted with their share of the
-            partition of unity. Σ_κ ψ_κ = 1 makes the latter the count of one non-overlapping
-            cover at the charts' own density, for any d and with or without boundary.
+        'used' (default, kept for the studies): the Gauss points kept (ψ_κ > tol_pu) over
+            n_cover × rule size, n_cover the simplices of one triangulation of the N points
+            (2N triangles for a closed surface, N segments for a closed curve; for d ≥ 3 the
+            PU-weighted count of 'paper2').
+        'paper2' (Paper 2 §1, Fig. 1): every Gauss point evaluated over Σ_κ Σ_g ψ_κ(x_g),
+            the count of one non-overlapping cover at the charts' density (Σ_κ ψ_κ = 1).
         See :meth:`redundancy_report` for all the counts.
         """
         r = self.redundancy_report()

@@ -74,6 +74,9 @@ class SurfaceGeometry:
             atlas.build_charts(lambda it, **kw: ctx.progress(it, **kw))
         with ctx.timed("quadrature"):
             atlas.build_quadrature(lambda it, **kw: ctx.progress(it, **kw))
+        if atlas.departed_splits_:
+            ctx.log.info("%d charts departed from their points and were split (%d charts)",
+                         atlas.departed_splits_, len(atlas.charts_))
         return atlas
 
     def run(self, ctx):
@@ -180,7 +183,8 @@ class SurfaceGeometry:
                 "depart from their points or carry weight on their rim")}),
             "patch_embedder": (("patch",), *_embedder_codes(atlas)),
             "patch_split_depth": (("patch",), atlas.patch_depth_, {**one, "long_name": (
-                "times the patch was bisected after the initial METIS partition (repair)")}),
+                "times the patch was bisected after the initial METIS partition (repair of "
+                "the chart test or of a chart departing from its points)")}),
             "patch_markers": (("patch",), sizes, {**one, "long_name": "markers in the patch"}),
             "patch_accepted": (("patch",), trusted.astype(np.int8), {**one, "long_name": (
                 "1 if the patch's chart passed the fold/stress/distortion test and stays on "

@@ -68,6 +68,7 @@ def test_sphere_willmore_on_dask_gives_the_figures_of_local(run_cli, tmp_path):
 def test_linear_hemisphere_on_dask_gives_the_figures_of_local(run_cli, tmp_path, cluster):
     """Atlas and assembly (tangent, residual) as tasks on an existing scheduler."""
     (a, b), log = run_pair(run_cli, tmp_path, "experiment=shell_hemisphere",
+                           "source.n_points=400",
                            dask_args=("executor=dask",
                                       f"executor.scheduler_address={cluster.scheduler_address}"))
     diff = numeric_differences(a, b)

@@ -23,17 +23,7 @@ import numpy as np
 
 from .chart_fidelity import departs
 from .orientation import frame_masks
-from .partition import metis_parts, split_disconnected
-
-#: a patch is only bisected if each half keeps at least this many markers (as the partition)
-MIN_HALF_MARKERS = 8
-
-
-def bisect(atlas, members: np.ndarray) -> list[np.ndarray]:
-    """The marker sets of the METIS bisection of patch ``members`` (connected parts)."""
-    sub = atlas.adjacency_[members][:, members]
-    halves = split_disconnected(sub, metis_parts(sub, 2))
-    return [members[halves == lab] for lab in np.unique(halves)]
+from .partition import MIN_PATCH_MARKERS, bisect_patch
 
 
 def split_departed_charts(atlas, frames: list, real, need_second: bool, keep_basis: bool,
@@ -41,7 +31,8 @@ def split_departed_charts(atlas, frames: list, real, need_second: bool, keep_bas
     """Replace every departing chart (after the atlas's quadrature) by the charts of its
     halves, while the halves pass the chart test and depart on at most half its area, up to
     ``max_refinement_depth``; updates labels_, accepted_, patch_depth_, patch_embedder_,
-    support_, charts_, quadrature_ and ``frames`` in place. Returns the number of charts split (also ``departed_splits_``).
+    support_, charts_, quadrature_ and ``frames`` in place. Returns the number of charts
+    split (also ``departed_splits_``).
 
     A split is kept only if every half passes the chart test; otherwise the chart stays and
     is refused or flagged as departing by the caller. Charts fitted once for the whole atlas
@@ -56,17 +47,18 @@ def split_departed_charts(atlas, frames: list, real, need_second: bool, keep_bas
         candidates = [k for k in sorted(splittable)
                       if departs(atlas.quadrature_[k].departure or {})
                       and atlas.patch_depth_[k] < s.max_refinement_depth
-                      and np.count_nonzero(atlas.labels_ == k) >= 2 * MIN_HALF_MARKERS]
+                      and np.count_nonzero(atlas.labels_ == k) >= 2 * MIN_PATCH_MARKERS]
         if not candidates:
             break
-        splits = {k: bisect(atlas, np.flatnonzero(atlas.labels_ == k)) for k in candidates}
+        splits = {k: bisect_patch(atlas.adjacency_, np.flatnonzero(atlas.labels_ == k))
+                  for k in candidates}
         atlas._prefetch_embeddings([h for halves in splits.values() for h in halves])
         splits = {k: halves for k, halves in splits.items()
                   if len(halves) > 1 and all(atlas._acceptable(h) for h in halves)}
         if not splits:
             break
         before = {k: departed_area(atlas.quadrature_[k]) for k in splits}
-        groups = _relabel(atlas, splits)
+        groups = _relabel(atlas, splits, progress)
         new_ids = [lab for labs in groups.values() for lab in labs]
         done = atlas._quadrature_of(new_ids, real, need_second, keep_basis, progress,
                                     desc="quadrature (split charts)")
@@ -94,7 +86,7 @@ def departed_area(q) -> float:
     return float((q.departure or {}).get("departed_weight", 0.0) * q.weights.sum())
 
 
-def _relabel(atlas, splits: dict[int, list[np.ndarray]]) -> dict[int, list[int]]:
+def _relabel(atlas, splits: dict[int, list[np.ndarray]], progress) -> dict[int, list[int]]:
     """Give each split patch's first half its label and the others new ones; build their
     charts. Returns, per split patch, the labels of its halves (whose charts are new)."""
     L = len(atlas.charts_)
@@ -115,7 +107,7 @@ def _relabel(atlas, splits: dict[int, list[np.ndarray]]) -> dict[int, list[int]]
     atlas.accepted_ = np.array(accepted, dtype=bool)
     new_ids = [lab for labs in groups.values() for lab in labs]
     atlas.support_ += [None] * (L - len(atlas.support_))
-    charts = atlas._charts_of(new_ids, lambda it, **kw: it, desc="charts (split)")
+    charts = atlas._charts_of(new_ids, progress, desc="charts (split)")
     atlas.charts_ += [None] * (L - len(atlas.charts_))
     for lab, chart in zip(new_ids, charts):
         atlas.charts_[lab] = chart

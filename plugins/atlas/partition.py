@@ -96,9 +96,21 @@ def partition_markers(markers: np.ndarray, n_parts: int, n_neighbors: int = 10
     return labels, A
 
 
+#: a patch is bisected only if each half can keep at least this many markers
+MIN_PATCH_MARKERS = 8
+
+
+def bisect_patch(adjacency: csr_matrix, members: np.ndarray) -> list[np.ndarray]:
+    """The marker sets of the METIS bisection of patch ``members`` (connected parts)."""
+    sub = adjacency[members][:, members]
+    halves = split_disconnected(sub, metis_parts(sub, 2))
+    return [members[halves == lab] for lab in np.unique(halves)]
+
+
 def refine_partition(labels: np.ndarray, adjacency: csr_matrix,
                      acceptable: Callable[[np.ndarray], bool], max_depth: int = 6,
-                     min_size: int = 8, prefetch: Optional[Callable[[list], None]] = None
+                     min_size: int = MIN_PATCH_MARKERS,
+                     prefetch: Optional[Callable[[list], None]] = None
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Recursively bisect (METIS) every patch for which ``acceptable(marker_indices)`` fails.
 
@@ -122,10 +134,7 @@ def refine_partition(labels: np.ndarray, adjacency: csr_matrix,
             if ok or depth >= max_depth or idx.size < 2 * min_size:
                 final.append((idx, ok, depth))
                 continue
-            sub = adjacency[idx][:, idx]
-            halves = split_disconnected(sub, metis_parts(sub, 2))
-            for lab in np.unique(halves):
-                split.append((idx[halves == lab], depth + 1))
+            split += [(half, depth + 1) for half in bisect_patch(adjacency, idx)]
         queue = split
     out = np.empty_like(labels)
     final.sort(key=lambda item: item[0].min())

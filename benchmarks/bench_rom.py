@@ -34,16 +34,25 @@ benchmarks/bench_rom.py`` (about 6 min in all, peak RSS 5.2 GB), 2026-12-05:
     NLIE, D = 898 (449 landmarks)      N 5 000: 15.0 s, 10 000: 48.0 s, 20 000: 98.1 s
     (--large, run alone earlier: N 50 000: 493 s, not converged, grad_max / tol = 160)
 
+NLIE again on 2026-12-07, after the Euclidean steps were made dimension-proof (duplicates by
+sorting, pruned farthest-point sampling, exact edge lengths), same sets:
+
+    NLIE, D = 898 (449 landmarks)      N 5 000: 5.0 s, 10 000: 19.8 s, 20 000: 35.4 s
+    (--large: N 50 000: 213 s, converged in 18 Newton iterations, grad_max / tol = 0.0013)
+
 The tabulated reduced model meets the 100× target by almost two orders of magnitude. The
 direct one (an LME evaluation of 2 035 nodes with second derivatives, D²X of the full mesh and
 a full-mesh energy and force, twice per step: the step and the saved energy) is 9× slower than
 the full model; before single points ran on one numba thread (``support.threads_for``) the
 thread team's wake-up made it 57 ms per step. The reduced dynamics (modes at 4.8 and
 19 rad/s) is sensitive: round-off in the fit changes max |q| between 0.37 and 0.47 from run to
-run, but the energy confines it inside the disc. NLIE here is 4.5–7× slower than the house
+run, but the energy confines it inside the disc. NLIE was 4.5–7× slower than the house
 NLIE reference (swiss roll, D = 3, benchmarks/results/bench_nlie.nc: 20 000 points in
-21.9 s): with D = 898 the Euclidean steps dominate (at N = 50 000: farthest-point sampling
-of the landmark-Isomap seed 183 s, check_distinct 93 s, k-NN graph 89 s, Newton 97 s).
+21.9 s): with D = 898 the Euclidean steps dominated (at N = 50 000: farthest-point sampling
+of the landmark-Isomap seed 183 s, check_distinct 93 s, k-NN graph 89 s, Newton 97 s). Now
+(N = 20 000): k-NN graph 11 s (scikit-learn's brute search, BLAS-bound: a ball tree is no
+faster here and 50× slower on full-rank data), farthest points 0.55 s, duplicates 1.0 s,
+the Newton stage 21 s (the swiss roll's, D-independent), landmark geodesics 9 s.
 
 Usage: python benchmarks/bench_rom.py [--quick] [--large] [--full-steps N] [--rom-steps N]
 ``--quick``: 2 000 triangles, NLIE at N = 2 000 only (a smoke check, well under a minute).
@@ -254,7 +263,7 @@ def time_nlie(body, sizes):
         info = model.info_
         return (time.perf_counter() - t0, info["newton_iter"],
                 info["grad_max"] / info["grad_tol"], bool(info["converged"]))
-    ctx.make("embedder", "nlie", n_stress_neighbors=20).fit_transform(
+    ctx.make("embedder", "nlie", n_stress_neighbors=20, seed_landmarks=50).fit_transform(
         family.snapshots(disc(300, 99), cols))                    # numba compile
     return len(nodes), {n: embed(n, SNAPSHOT_SEED + 1) for n in sizes}
 

@@ -74,12 +74,39 @@ def validate_points(X, *, what: str = "points", min_points: int = 1) -> np.ndarr
 
 
 def check_distinct(X: np.ndarray, *, what: str = "points", tol: float = 0.0) -> None:
-    """Raise :class:`InputError` if two rows of ``X`` coincide (within ``tol``)."""
-    from scipy.spatial import cKDTree
+    """Raise :class:`InputError` if two rows of ``X`` coincide (within ``tol``).
 
-    pairs = cKDTree(X).query_pairs(r=max(tol, 0.0), output_type="ndarray")
-    if len(pairs):
+    Exact duplicates (``tol`` 0) are found by sorting the rows' bytes (signed zeros made
+    equal), O(N log N) comparisons whatever the dimension; a k-d tree would degrade to pairwise
+    work in high dimension (20 000 snapshots in R^898: 1.0 s against 30 s for the tree). ``tol`` > 0 uses
+    the k-d tree's pairs within ``tol``.
+    """
+    X = np.asarray(X, dtype=np.float64)
+    if tol > 0.0:
+        from scipy.spatial import cKDTree
+
+        pairs = cKDTree(X).query_pairs(r=tol, output_type="ndarray")
+        n_pairs, first = len(pairs), (sorted(pairs[0].tolist()) if len(pairs) else None)
+    else:
+        n_pairs, first = _exact_duplicates(X)
+    if n_pairs:
         raise InputError(
-            f"{what} contain {len(pairs)} duplicate pair(s) (first: rows {pairs[0].tolist()}). "
+            f"{what} contain {n_pairs} duplicate pair(s) (first: rows {first}). "
             "Remove duplicates, e.g. np.unique(points, axis=0)."
         )
+
+
+def _exact_duplicates(X: np.ndarray) -> tuple[int, list[int] | None]:
+    """(number of coinciding row pairs, the two lowest rows of the first repeated row)."""
+    if X.shape[0] < 2 or X.shape[1] == 0:
+        return (X.shape[0] * (X.shape[0] - 1) // 2, [0, 1]) if X.shape[0] > 1 else (0, None)
+    rows = np.ascontiguousarray(X + 0.0)                 # -0.0 -> 0.0, so bytes equal <=> values
+    keys = rows.view(np.dtype((np.void, rows.itemsize * rows.shape[1]))).ravel()
+    _, first_row, inverse, counts = np.unique(keys, return_index=True, return_inverse=True,
+                                              return_counts=True)
+    repeated = counts > 1
+    if not repeated.any():
+        return 0, None
+    n_pairs = int((counts[repeated] * (counts[repeated] - 1) // 2).sum())
+    group = int(np.flatnonzero(repeated)[np.argmin(first_row[repeated])])
+    return n_pairs, np.flatnonzero(inverse.ravel() == group)[:2].tolist()

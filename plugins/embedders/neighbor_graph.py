@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
+from numba import njit, prange
 from scipy.sparse.csgraph import connected_components
 
 from pointatlas.errors import InputError
@@ -19,17 +20,39 @@ def neighbor_graph(X: np.ndarray, n_neighbors: int | None = 12,
 
     An edge joins a and b when b is among the ``n_neighbors`` nearest of a *or* a among those of
     b (the union, as Isomap does), or, with ``radius``, when |x_a - x_b| <= radius.
+    The neighbours are searched on the centred points and every edge length is then
+    recomputed as |x_a - x_b| from the coordinates: in high dimension scikit-learn's brute
+    search uses |x|² + |y|² - 2 x·y, which on snapshots far from the origin (898 coordinates
+    of a body, spacing 1e-2) errs by 3e-7 relative; the lengths here are exact to round-off.
     Units: those of ``X``. Returns an (N, N) CSR matrix with sorted indices and no diagonal.
     """
     from sklearn.neighbors import kneighbors_graph, radius_neighbors_graph
 
+    X = np.asarray(X, dtype=np.float64)
+    centred = X - X.mean(axis=0)
     if n_neighbors is not None:
-        G = kneighbors_graph(X, n_neighbors, mode="distance", include_self=False)
+        G = kneighbors_graph(centred, n_neighbors, mode="distance", include_self=False)
     else:
-        G = radius_neighbors_graph(X, radius, mode="distance", include_self=False)
+        G = radius_neighbors_graph(centred, radius, mode="distance", include_self=False)
+    G = G.tocoo()
+    G.data = edge_lengths(X, G.row.astype(np.int64), G.col.astype(np.int64))
+    G = G.tocsr()
     G = G.maximum(G.T).tocsr()
     G.sort_indices()
     return G
+
+
+@njit(cache=True, parallel=True)
+def edge_lengths(X: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """|x_row - x_col| per edge, from coordinate differences (units of ``X``)."""
+    out = np.empty(rows.size)
+    for e in prange(rows.size):
+        s = 0.0
+        for c in range(X.shape[1]):
+            t = X[rows[e], c] - X[cols[e], c]
+            s += t * t
+        out[e] = np.sqrt(s)
+    return out
 
 
 def describe_graph(n_neighbors: int | None, radius: float | None) -> str:

@@ -3,7 +3,11 @@ staggered scheme taking over where it gives up. On the small centre-cracked plat
 test_fracture both schemes reach the same path (the same minimisers of the same energy), the
 monolithic one solves the increments before the crack jump in 5–9 Newton iterations
 (staggered: 5–43) and hands the jump, where the coupled tangent is indefinite, to the
-staggered iteration; irreversibility holds exactly either way."""
+staggered iteration; irreversibility holds exactly either way.
+
+The two plate runs take two minutes of CI time: the comparison is a study (``-m slow``); the
+default suite keeps the monolithic Newton's own check
+(test_fracture_nonlinear::test_monolithic_newton_meets_the_same_solution) and the refusals."""
 import numpy as np
 import pytest
 
@@ -17,6 +21,7 @@ def both(tmp_path_factory, run_plate):
             run_plate(root / "stag", TIGHT))
 
 
+@pytest.mark.slow
 def test_both_schemes_follow_the_same_path(both):
     mono, stag = both
     # measured: υ within 3.5e-7, the staggered tolerance's size; reactions alike
@@ -29,6 +34,7 @@ def test_both_schemes_follow_the_same_path(both):
     assert np.all(np.diff(mono["phase_field"].values, axis=0) <= 0.0)
 
 
+@pytest.mark.slow
 def test_monolithic_newton_solves_the_stable_increments_and_hands_over_the_jump(both):
     mono, stag = both
     m = mono["monolithic_iterations"].values[1:]

@@ -70,9 +70,13 @@ def _check_snapshots(series, ds):
         assert mesh.field_data["load_units"][0] == "N"
 
 
+@pytest.mark.slow
 def test_nonlinear_run_on_a_vtp_point_cloud_needs_no_code(tmp_path, run_cli):
     """The open hemisphere's points as a .vtp file, supports, loads and monitors given only
-    on the command line: the same path as the built-in experiment (Sze et al. at 0.1 P_max)."""
+    on the command line: the same path as the built-in experiment (Sze et al. at 0.1 P_max).
+    A study (``-m slow``, a minute of CI): the default suite runs a user's point file with
+    selectors through the linear shell (test_shell::test_own_point_cloud_file_with_selectors_
+    needs_no_code) and the nonlinear path from the command line (above)."""
     import numpy as np
     import pyvista as pv
 

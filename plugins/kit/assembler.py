@@ -12,6 +12,7 @@ thread evaluates the energy kernels chunk by chunk, so the pointwise Hessians of
 """
 from __future__ import annotations
 
+import itertools
 from typing import Sequence
 
 import numpy as np
@@ -56,6 +57,10 @@ class _Term:
         self.n_parts = len(energy.density_names)
 
 
+#: numbers of the assemblers of this process (their keys on a distributed executor)
+_SHARED_IDS = itertools.count()
+
+
 class Assembler:
     """Energy, densities, residual and tangent of ``energies`` on ``quadrature``."""
 
@@ -71,6 +76,11 @@ class Assembler:
             raise ConfigError(f"field(s) {unused} are declared but no energy uses them: "
                               "remove them from the physics' fields or add the energy that "
                               "needs them.")
+        # the key under which a distributed executor keeps this assembler's copy on the
+        # cluster: a number no other assembler of this process gets (``id(self)`` is reused
+        # once an assembler is freed, and a later one was then computed with the earlier
+        # one's energies: a load residual on dask took another load's assembler)
+        self._shared_id = next(_SHARED_IDS)
         self._data_version = 0
         self.part_names = [f"{type(t.energy).__name__}.{n}" if len(self.terms) > 1 else n
                            for t in self.terms for n in t.energy.density_names]
@@ -169,7 +179,7 @@ class Assembler:
         if executor.distributed and len(items) > 0:
             self.q.assembly_plan()  # computed here, sent with the assembler
             return executor.map(fn, items, shared=self, desc=f"{what} assembly",
-                                shared_key=("assembler", id(self), self._data_version),
+                                shared_key=("assembler", self._shared_id, self._data_version),
                                 labels=[f"{what} part {i}" for i in range(len(items))])
         return run_threads(lambda *item: fn(self, item), items)
 

@@ -34,9 +34,9 @@ def neighbor_graph(X: np.ndarray, n_neighbors: int | None = 12,
         G = kneighbors_graph(centred, n_neighbors, mode="distance", include_self=False)
     else:
         G = radius_neighbors_graph(centred, radius, mode="distance", include_self=False)
-    G = G.tocoo()
-    G.data = edge_lengths(X, G.row.astype(np.int64), G.col.astype(np.int64))
     G = G.tocsr()
+    rows = np.repeat(np.arange(G.shape[0], dtype=np.int64), np.diff(G.indptr))
+    G.data = edge_lengths(X, rows, G.indices.astype(np.int64))
     G = G.maximum(G.T).tocsr()
     G.sort_indices()
     return G

@@ -131,8 +131,8 @@ def check_composition(overrides: list[str], multirun: bool = False) -> bool:
     from .config_check import check_run_config
 
     task = [o for o in overrides if not o.startswith("hydra")]
-    config, choices, sweeper = _compose(task if not multirun else [
-        o for o in task if "," not in o and "(" not in o])
+    first = task if not multirun else [o for o in task if "," not in o and "(" not in o]
+    config, choices, sweeper = _compose(first)
     jobs = [task]
     multirun = multirun or sweeper.get("mode") == "MULTIRUN"
     if multirun:
@@ -143,7 +143,7 @@ def check_composition(overrides: list[str], multirun: bool = False) -> bool:
         except Exception:  # noqa: BLE001 - a sweep syntax Hydra itself will explain
             jobs = []
     for job in jobs:
-        if job != task or not multirun:
+        if job != first:  # a single run's config is the one composed above
             config, choices, _ = _compose(job)
         try:
             check_run_config(config, choices)

@@ -32,3 +32,22 @@ def test_experiments_have_usage_comment_and_reference():
         text = path.read_text()
         assert text.startswith("# @package _global_"), name
         assert f"# Usage: pointatlas experiment={name}" in text, name
+
+
+def test_a_single_run_is_composed_once_and_each_sweep_job_once_more(monkeypatch):
+    """Start-up composes a single run's config once (each compose costs a deep copy of the
+    whole config store); a sweep composes its first job's base, then each job."""
+    from pointatlas import cli
+
+    calls = []
+    compose_once = cli._compose
+    monkeypatch.setattr(cli, "_compose", lambda overrides: calls.append(overrides) or
+                        compose_once(overrides))
+    assert cli.check_composition(["experiment=sphere_willmore", "source.n_points=300"]) is False
+    assert calls == [["experiment=sphere_willmore", "source.n_points=300"]]
+    calls.clear()
+    assert cli.check_composition(["experiment=sphere_willmore", "source.n_points=300,400"],
+                                 multirun=True) is True
+    assert calls == [["experiment=sphere_willmore"],
+                     ["experiment=sphere_willmore", "source.n_points=300"],
+                     ["experiment=sphere_willmore", "source.n_points=400"]]

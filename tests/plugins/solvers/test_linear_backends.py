@@ -184,3 +184,31 @@ def test_pardiso_gives_the_same_bits_in_two_processes():
     lines = [o.stdout.split() for o in out]
     assert lines[0][0] == "AUTO,STRICT"
     assert lines[0][1] == lines[1][1]
+
+
+_IMPORT_WITHOUT_A_WALK = r"""
+import glob
+def walk(*args, **kwargs):
+    raise AssertionError("pypardiso walked the environment for MKL")
+glob.glob = walk
+import os
+from pointatlas_solvers.linear_backends import installed
+assert installed("pardiso")
+import pypardiso
+print(os.environ["PYPARDISO_MKL_RT"], pypardiso.ps.libmkl._name)
+"""
+
+
+@pytest.mark.skipif(not installed("pardiso"), reason="needs pypardiso (extra fast)")
+def test_pardiso_loads_the_mkl_of_the_mkl_wheel_without_walking_the_environment():
+    """PYPARDISO_MKL_RT is set from the ``mkl`` distribution's file list before pypardiso is
+    imported: pypardiso loads that library and does not glob the environment for one."""
+    import os
+    import subprocess
+
+    env = {k: v for k, v in os.environ.items() if k != "PYPARDISO_MKL_RT"}
+    out = subprocess.run([sys.executable, "-c", _IMPORT_WITHOUT_A_WALK], capture_output=True,
+                         text=True, env=env, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    named, loaded = out.stdout.split()
+    assert named == loaded and os.path.isfile(loaded) and "mkl_rt" in os.path.basename(loaded)

@@ -105,7 +105,11 @@ class Family:
         free = body.free_dofs
         K = body.tangent(body.reference)[free][:, free].tocsc()
         m = np.repeat(body.nodal_masses, 2)
-        w2, vec = eigsh(K, k=4, M=diags(m[free]).tocsc(), sigma=0, which="LM")
+        # a fixed start vector and sign (ARPACK's default start is random: the family, and so
+        # the timings of the embedders on it, changed from process to process)
+        w2, vec = eigsh(K, k=4, M=diags(m[free]).tocsc(), sigma=0, which="LM",
+                        v0=np.ones(K.shape[0]))
+        vec *= np.sign(vec[np.argmax(np.abs(vec), axis=0), np.arange(vec.shape[1])])
         order = np.argsort(w2)
         self.omega = np.sqrt(w2[order])
         phi = np.zeros((2 * body.mesh.n_nodes, 4))

@@ -13,6 +13,8 @@ from scipy.sparse.csgraph import connected_components
 
 from pointatlas.errors import InputError
 
+from .projected_knn import projected_kneighbors
+
 
 def neighbor_graph(X: np.ndarray, n_neighbors: int | None = 12,
                    radius: float | None = None) -> sp.csr_matrix:
@@ -24,11 +26,22 @@ def neighbor_graph(X: np.ndarray, n_neighbors: int | None = 12,
     recomputed as |x_a - x_b| from the coordinates: in high dimension scikit-learn's brute
     search uses |x|² + |y|² - 2 x·y, which on snapshots far from the origin (898 coordinates
     of a body, spacing 1e-2) errs by 3e-7 relative; the lengths here are exact to round-off.
+    Above 15 coordinates, k nearest neighbours are searched through a projection
+    (:mod:`.projected_knn`, exact, ties to the lower index) where it prunes.
     Units: those of ``X``. Returns an (N, N) CSR matrix with sorted indices and no diagonal.
     """
     from sklearn.neighbors import kneighbors_graph, radius_neighbors_graph
 
     X = np.asarray(X, dtype=np.float64)
+    found = (projected_kneighbors(X, int(n_neighbors))
+             if n_neighbors is not None and X.shape[1] > 15 else None)
+    if found is not None:  # exact, and found through a projection (high dimension)
+        idx, dist = found
+        n, k = idx.shape
+        G = sp.csr_matrix((dist.ravel(), idx.ravel(), np.arange(0, n * k + 1, k)), shape=(n, n))
+        G = G.maximum(G.T).tocsr()
+        G.sort_indices()
+        return G
     centred = X - X.mean(axis=0)
     if n_neighbors is not None:
         G = kneighbors_graph(centred, n_neighbors, mode="distance", include_self=False)

@@ -8,7 +8,8 @@ projection (m = 10 principal directions of a subsample), measures them in full d
 then measures every point of the projected ball: the neighbours found are the exact ones
 (ties at the k-th distance go to the lower index), while only O(k) full-dimensional
 distances per point are computed when the points lie near an m-dimensional subspace
-(snapshots of a body: 20 000 × 898 coordinates in 2.4 s, against 13 s for a brute search).
+(snapshots of a body: 20 000 × 898 coordinates, k = 12, in 1.9–2.8 s against 12–13 s for
+scikit-learn's brute search, measured on 2 cores; the same edges).
 
 When the projection keeps less than :data:`MIN_CAPTURED` of the variance, or the balls hold
 more than :data:`BALL_BUDGET` points per point on average, the pruning would not pay and
@@ -100,8 +101,11 @@ def projected_kneighbors(X: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]
     _row_distances(X, ptr, cand, dist)
     idx0, d0 = np.empty((n, k), np.int64), np.empty((n, k))
     _k_smallest(ptr, cand, dist, k, idx0, d0)
-    # widened by the round-off of the projected distances (|Z| ε, relative 1e-12)
-    radius = d0[:, -1] * (1.0 + 1e-12) + 64 * np.finfo(float).eps * np.abs(Z).max()
+    # widened by the round-off of the distances: relative 1e-12, and for the projection
+    # Z = centred V an absolute 4 √D ε max|centred row| (a projected distance may exceed the
+    # true one by that much where the two are equal)
+    scale = np.sqrt(np.einsum("ij,ij->i", centred, centred).max())
+    radius = d0[:, -1] * (1.0 + 1e-12) + 4.0 * np.sqrt(D) * np.finfo(float).eps * scale
     sizes = tree.query_ball_point(Z, radius, return_length=True)
     if sizes.sum() > BALL_BUDGET * k * n:
         return None

@@ -5,7 +5,10 @@ Hessian may be indefinite: CG stops at negative curvature (Steihaug) and the ste
 with a positive semidefinite ("convex") approximation of the Hessian supplied by the caller, a
 Gauss-Newton-like modification that always gives a descent direction. Near the minimum the true
 Hessian is used, and the inexact Newton steps converge superlinearly (forcing term
-eta_k = min(0.1, sqrt(|g_k| / |g_0|)), Eisenstat-Walker).
+eta_k = min(0.1, sqrt(|g_k| / |g_0|)), Eisenstat-Walker). Steps are accepted by Armijo's
+test, and from the first step whose decrease is below the round-off of f by the approximate
+Wolfe conditions (:func:`approximate_wolfe_step`): NLIE's stress on 50 000 snapshots had
+stopped with its gradient 3.4 times its tolerance for that reason.
 """
 from __future__ import annotations
 
@@ -72,6 +75,7 @@ def newton_line_search(fun_grad: Callable, fun: Callable, hess: Callable, x0: np
     n_convex = 0
     done = bool(converged(g))
     it = 0
+    noisy = False                            # f's round-off hides Armijo's decrease
     while not done and it < max_iter:
         it += 1
         eta = min(0.1, np.sqrt(np.linalg.norm(g) / g0))
@@ -88,14 +92,40 @@ def newton_line_search(fun_grad: Callable, fun: Callable, hess: Callable, x0: np
             step = -precond(g)
             slope = g @ step
         alpha = 1.0
-        while alpha > 1e-10:
+        while alpha > 1e-10 and not noisy:
             f_new = fun(x + alpha * step)
             if np.isfinite(f_new) and f_new <= f + 1e-4 * alpha * slope:
                 break
             alpha *= 0.5
-        else:
-            break                            # no decrease: stationary to machine precision
+        else:   # no decrease f's round-off lets us see: from here on, as Hager & Zhang do,
+            noisy = True                     # the approximate Wolfe conditions
+            found = approximate_wolfe_step(fun_grad, x, f, slope, step)
+            if found is None:
+                break                        # stationary to machine precision
+            x, f, g = found
+            done = bool(converged(g))
+            continue
         x = x + alpha * step
         f, g = fun_grad(x)
         done = bool(converged(g))
     return NewtonResult(x, float(f), float(np.abs(g).max()), it, cg_total, done, n_convex, g)
+
+
+def approximate_wolfe_step(fun_grad: Callable, x: np.ndarray, f: float, slope: float,
+                           step: np.ndarray, *, delta: float = 0.1, sigma: float = 0.9,
+                           eps: float = 1e-6, tries: int = 4):
+    """(x + a step, f, g) for the first a = 1, 1/2, ... meeting the approximate Wolfe
+    conditions of Hager & Zhang (SIAM J. Optim. 16:170, 2005, Eq. 4.1 with their ε = 1e-6):
+    f(x + a step) <= f + eps |f| and (2 delta - 1) phi'(0) >= phi'(a) >= sigma phi'(0), with
+    phi'(a) = g(x + a step) . step; None if none does. Used where Armijo's decrease is below
+    the round-off of f (a sum over millions of pairs near its minimum): the directional
+    derivative, exact to round-off, still tells a step that approaches the minimum."""
+    a = 1.0
+    for _ in range(tries):
+        f_new, g_new = fun_grad(x + a * step)
+        d_new = float(g_new @ step)
+        if (np.isfinite(f_new) and f_new <= f + eps * abs(f)
+                and (2 * delta - 1) * slope >= d_new >= sigma * slope):
+            return x + a * step, f_new, g_new
+        a *= 0.5
+    return None

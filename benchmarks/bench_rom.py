@@ -40,6 +40,16 @@ sorting, pruned farthest-point sampling, exact edge lengths), same sets:
     NLIE, D = 898 (449 landmarks)      N 5 000: 5.0 s, 10 000: 19.8 s, 20 000: 35.4 s
     (--large: N 50 000: 213 s, converged in 18 Newton iterations, grad_max / tol = 0.0013)
 
+Later that day: the k-NN graph through a projection (``projected_knn``: exact, 1.9–2.8 s at
+20 000 against 12–13 s), the family built from a fixed ARPACK start and sign (it had been
+random, and so were NLIE's iteration counts: 11–15 at 20 000), and Newton's approximate
+Wolfe steps at the round-off floor (50 000 had stopped at 3.4× its gradient tolerance):
+
+    NLIE, D = 898 (449 landmarks)      N 5 000: 6.2 s (12 Newton iterations),
+                                       10 000: 22.4–25.8 s (33), 20 000: 24.1–30.4 s (14)
+    (--large: N 50 000: 188.5 s, converged in 29 Newton iterations, grad_max / tol = 0.15)
+    house swiss roll, same session     N 20 000: 35.4–38.2 s (stored 21.9 s, another day)
+
 The tabulated reduced model meets the 100× target by almost two orders of magnitude. The
 direct one (an LME evaluation of 2 035 nodes with second derivatives, D²X of the full mesh and
 a full-mesh energy and force, twice per step: the step and the saved energy) is 9× slower than

@@ -8,12 +8,11 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
-from numba import njit, prange
 from scipy.sparse.csgraph import connected_components
 
 from pointatlas.errors import InputError
 
-from .projected_knn import projected_kneighbors
+from .projected_knn import edge_lengths, projected_kneighbors
 
 
 def neighbor_graph(X: np.ndarray, n_neighbors: int | None = 12,
@@ -39,33 +38,16 @@ def neighbor_graph(X: np.ndarray, n_neighbors: int | None = 12,
         idx, dist = found
         n, k = idx.shape
         G = sp.csr_matrix((dist.ravel(), idx.ravel(), np.arange(0, n * k + 1, k)), shape=(n, n))
-        G = G.maximum(G.T).tocsr()
-        G.sort_indices()
-        return G
-    centred = X - X.mean(axis=0)
-    if n_neighbors is not None:
-        G = kneighbors_graph(centred, n_neighbors, mode="distance", include_self=False)
     else:
-        G = radius_neighbors_graph(centred, radius, mode="distance", include_self=False)
-    G = G.tocsr()
-    rows = np.repeat(np.arange(G.shape[0], dtype=np.int64), np.diff(G.indptr))
-    G.data = edge_lengths(X, rows, G.indices.astype(np.int64))
+        centred = X - X.mean(axis=0)
+        G = (kneighbors_graph(centred, n_neighbors, mode="distance", include_self=False)
+             if n_neighbors is not None else
+             radius_neighbors_graph(centred, radius, mode="distance", include_self=False)).tocsr()
+        rows = np.repeat(np.arange(G.shape[0], dtype=np.int64), np.diff(G.indptr))
+        G.data = edge_lengths(X, rows, G.indices.astype(np.int64))
     G = G.maximum(G.T).tocsr()
     G.sort_indices()
     return G
-
-
-@njit(cache=True, parallel=True)
-def edge_lengths(X: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
-    """|x_row - x_col| per edge, from coordinate differences (units of ``X``)."""
-    out = np.empty(rows.size)
-    for e in prange(rows.size):
-        s = 0.0
-        for c in range(X.shape[1]):
-            t = X[rows[e], c] - X[cols[e], c]
-            s += t * t
-        out[e] = np.sqrt(s)
-    return out
 
 
 def describe_graph(n_neighbors: int | None, radius: float | None) -> str:

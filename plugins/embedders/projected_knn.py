@@ -29,16 +29,16 @@ BALL_BUDGET = 40        # mean projected-ball size per point and neighbour beyon
 
 
 @njit(cache=True, parallel=True)
-def _row_distances(X, ptr, idx, out):
-    """out[t] = |x_i - x_idx[t]| for ptr[i] <= t < ptr[i+1] (coordinate differences)."""
-    for i in prange(len(ptr) - 1):
-        for t in range(ptr[i], ptr[i + 1]):
-            j = idx[t]
-            s = 0.0
-            for c in range(X.shape[1]):
-                d = X[i, c] - X[j, c]
-                s += d * d
-            out[t] = np.sqrt(s)
+def edge_lengths(X: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """|x_row - x_col| per edge, from coordinate differences (units of ``X``)."""
+    out = np.empty(rows.size)
+    for e in prange(rows.size):
+        s = 0.0
+        for c in range(X.shape[1]):
+            t = X[rows[e], c] - X[cols[e], c]
+            s += t * t
+        out[e] = np.sqrt(s)
+    return out
 
 
 @njit(cache=True, parallel=True)
@@ -97,8 +97,7 @@ def projected_kneighbors(X: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]
     _, cand = tree.query(Z, k=first)
     ptr = np.arange(0, n * first + 1, first, dtype=np.int64)
     cand = cand.astype(np.int64).ravel()
-    dist = np.empty(cand.size)
-    _row_distances(X, ptr, cand, dist)
+    dist = edge_lengths(X, np.repeat(np.arange(n, dtype=np.int64), first), cand)
     idx0, d0 = np.empty((n, k), np.int64), np.empty((n, k))
     _k_smallest(ptr, cand, dist, k, idx0, d0)
     # widened by the round-off of the distances: relative 1e-12, and for the projection
@@ -106,11 +105,11 @@ def projected_kneighbors(X: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]
     # true one by that much where the two are equal)
     scale = np.sqrt(np.einsum("ij,ij->i", centred, centred).max())
     radius = d0[:, -1] * (1.0 + 1e-12) + 4.0 * np.sqrt(D) * np.finfo(float).eps * scale
-    sizes = tree.query_ball_point(Z, radius, return_length=True)
-    if sizes.sum() > BALL_BUDGET * k * n:
+    # counted before the balls are listed, so that balls too large for the pruning to pay
+    # are never held in memory
+    if tree.query_ball_point(Z, radius, return_length=True).sum() > BALL_BUDGET * k * n:
         return None
     ptr, ball = _lists(tree.query_ball_point(Z, radius))
-    dist = np.empty(ball.size)
-    _row_distances(X, ptr, ball, dist)
+    dist = edge_lengths(X, np.repeat(np.arange(n, dtype=np.int64), np.diff(ptr)), ball)
     _k_smallest(ptr, ball, dist, k, idx0, d0)
     return idx0, d0

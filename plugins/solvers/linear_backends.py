@@ -31,6 +31,7 @@ A backend that is not installed is refused with a :class:`ConfigError` naming th
 """
 from __future__ import annotations
 
+import functools
 import os
 
 import numpy as np
@@ -243,15 +244,18 @@ def _reproducible_mkl() -> None:
             os.environ["PYPARDISO_MKL_RT"] = library
 
 
+@functools.cache
 def _mkl_runtime_library() -> str | None:
-    """Path of libmkl_rt shipped by the installed ``mkl`` distribution, or None."""
+    """Path of libmkl_rt shipped by the installed ``mkl`` distribution, or None (looked up
+    once a process)."""
     from importlib import metadata
 
     try:
         files = metadata.distribution("mkl").files or []
     except metadata.PackageNotFoundError:
         return None
-    for name in sorted((f for f in files if f.name.startswith(("libmkl_rt.", "mkl_rt."))), key=str):
+    runtimes = (f for f in files if f.name.startswith(("libmkl_rt.", "mkl_rt.")))
+    for name in sorted(runtimes, key=str):
         path = os.path.realpath(name.locate())
         if os.path.isfile(path):
             return path

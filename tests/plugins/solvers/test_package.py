@@ -7,7 +7,7 @@ import pointatlas_solvers
 
 PACKAGE = Path(pointatlas_solvers.__file__).parent
 ALLOWED = ("numpy", "scipy", "pyamg", "pypardiso", "pointatlas", "__future__", "dataclasses",
-           "typing", "time", "os", "importlib")
+           "typing", "time", "os", "importlib", "functools")
 
 
 def _imports(path: Path):

@@ -8,8 +8,8 @@ With the jet tables of :class:`.fields.FieldLayout` (``col[r]`` the basis column
     K_ab[I, J]      += w_q Σ_{r: dof[r]=I} Σ_{s: dof[s]=J} p_a,col[r] H_q[r, s] p_b,col[s]
 
 evaluated, for the tangent, through G[a, I, s] = w_q Σ_{r: dof[r]=I} p_a,col[r] H_q[r, s],
-so a node pair costs B·n_jet operations; with one field the products of a point are one
-matrix product (BLAS, all node pairs). The tangent of a point block is accumulated in a
+so a node pair costs B·n_jet operations; with one field the products of a batch of
+neighbouring points are one matrix product (BLAS, all node pairs of the batch). The tangent of a point block is accumulated in a
 dense (|L|, |L|, B, B) array over the block's node set L (several fields: pairs a ≤ b, K
 being symmetric) and flushed once into the block-CSR data of the plan (:mod:`.assembly_plan`).
 """
@@ -85,16 +85,16 @@ def _tangent_blocks(blk0, blk1, order, block_ptr, first, indptr, indices, basis,
                     nL += 1
         Kloc = np.zeros((nL, nL, B, B))
         blkv = np.empty((B, B))
-        for k in range(block_ptr[blk], block_ptr[blk + 1]):
+        if nf == 1:
+            _one_field_batches(block_ptr[blk], block_ptr[blk + 1], first, order, indptr,
+                               indices, basis, weights, H, fcol[0], fncol[0], B, gl, nL,
+                               Kloc)
+        for k in range(block_ptr[blk], block_ptr[blk + 1] if nf > 1 else 0):
             q = order[k]
             h = k - first
             t0 = indptr[q]
             n = indptr[q + 1] - t0
             w = weights[q]
-            if nf == 1:
-                _one_field_point(t0, n, w, basis, H[h], fcol[0], fncol[0], B, indices, gl,
-                                 Kloc)
-                continue
             G = np.zeros((n, B, n_jet))
             for a in range(n):
                 for r in range(n_jet):
@@ -131,30 +131,77 @@ def _tangent_blocks(blk0, blk1, order, block_ptr, first, indptr, indices, basis,
 
 
 @njit(cache=True, nogil=True)
-def _one_field_point(t0, n, w, basis, Hq, c0, nc, B, indices, gl, Kloc):
-    """Kloc[a, b] += K_ab of one point of a single-field layout (jet (nc, B) row by row):
-    K_ab[i, j] = Σ_kk p_b,kk G2[kk, (a, i, j)], G2[kk, (a, i, j)] = w Σ_k' p_a,k' H[k'B + i,
-    kk B + j], as one matrix product Φ G2 (BLAS; all pairs, no symmetry bookkeeping)."""
-    Phi = np.empty((n, nc))
-    for a in range(n):
-        for kk in range(nc):
-            Phi[a, kk] = basis[t0 + a, c0 + kk]
-    G2 = np.zeros((nc, n * B * B))
-    for a in range(n):
-        for kp in range(nc):
-            p = w * Phi[a, kp]
-            if p != 0.0:
+def _one_field_batches(k0, k1, first, order, indptr, indices, basis, weights, H, c0, nc, B,
+                       gl, nL, Kloc):
+    """Kloc += the tangent of the points order[k0:k1] of a single-field layout, in batches of
+    consecutive points whose supports overlap (the plan orders points by nearest node).
+
+    For a batch S with union node set L_S, K_ab[i, j] = Σ_{q∈S} Σ_kk p_b,kk(q) G[(q, kk),
+    (a, i, j)], G[(q, kk), (a, i, j)] = w_q Σ_k' p_a,k'(q) H_q[k'B + i, kk B + j]: one matrix
+    product Φ_S G (BLAS) of (|L_S|, |S| nc) by (|S| nc, |L_S| B²) per batch; G's rows of a
+    point are themselves one product Φ_q H̃_q. A batch grows while its union stays within
+    3/2 of the largest support (so Φ_S is mostly nonzero) and it holds at most 32 points
+    (hemisphere, 90 nodes per point: 2.5x faster than one product per point).
+    """
+    nmax = 1
+    for k in range(k0, k1):
+        nmax = max(nmax, indptr[order[k] + 1] - indptr[order[k]])
+    cap = (3 * nmax) // 2
+    BB = B * B
+    sub = np.full(nL, -1, np.int64)   # block-local node -> batch-local node
+    snodes = np.empty(nL, np.int64)
+    Hr = np.empty((nc, nc * BB))
+    k = k0
+    while k < k1:
+        s0 = k
+        nS = 0
+        while k < k1 and k - s0 < 32:
+            q = order[k]
+            new = 0
+            for t in range(indptr[q], indptr[q + 1]):
+                if sub[gl[indices[t]]] < 0:
+                    new += 1
+            if k > s0 and nS + new > cap:
+                break
+            for t in range(indptr[q], indptr[q + 1]):
+                la = gl[indices[t]]
+                if sub[la] < 0:
+                    sub[la] = nS
+                    snodes[nS] = la
+                    nS += 1
+            k += 1
+        mS = k - s0
+        PhiS = np.zeros((nS, nc * mS))
+        G = np.zeros((nc * mS, nS * BB))
+        for j in range(mS):
+            q = order[s0 + j]
+            h = s0 + j - first
+            t0 = indptr[q]
+            n = indptr[q + 1] - t0
+            w = weights[q]
+            Phi = np.empty((n, nc))
+            for a in range(n):
+                for kk in range(nc):
+                    Phi[a, kk] = basis[t0 + a, c0 + kk]
+            for kp in range(nc):
                 for i in range(B):
-                    r = kp * B + i
                     for kk in range(nc):
-                        o = a * B * B + i * B
-                        for j in range(B):
-                            G2[kk, o + j] += p * Hq[r, kk * B + j]
-    P = np.dot(Phi, G2)  # P[b, (a, i, j)] = K_ab[i, j]
-    for a in range(n):
-        la = gl[indices[t0 + a]]
-        for b in range(n):
-            lb = gl[indices[t0 + b]]
-            for i in range(B):
-                for j in range(B):
-                    Kloc[la, lb, i, j] += P[b, a * B * B + i * B + j]
+                        for jj in range(B):
+                            Hr[kp, kk * BB + i * B + jj] = w * H[h, kp * B + i, kk * B + jj]
+            T = np.dot(Phi, Hr)  # T[a, (kk, i, j)] = G[(q, kk), (a, i, j)]
+            for a in range(n):
+                sa = sub[gl[indices[t0 + a]]]
+                for kk in range(nc):
+                    PhiS[sa, j * nc + kk] += Phi[a, kk]
+                    for r in range(BB):
+                        G[j * nc + kk, sa * BB + r] += T[a, kk * BB + r]
+        P = np.dot(PhiS, G)  # P[b, (a, i, j)] = K_ab[i, j]
+        for a in range(nS):
+            la = snodes[a]
+            for b in range(nS):
+                lb = snodes[b]
+                for i in range(B):
+                    for j in range(B):
+                        Kloc[la, lb, i, j] += P[b, a * BB + i * B + j]
+        for a in range(nS):
+            sub[snodes[a]] = -1

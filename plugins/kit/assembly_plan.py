@@ -48,42 +48,135 @@ def n_threads(n_items: int) -> int:
 
 
 @njit(cache=True, nogil=True)
-def _pattern_rows(indptr, indices, tptr, tpts, a0, a1, row_ptr, cols, count_only, row_len):
-    """Rows a0..a1 of the node pattern: count (row_len[a+1]) or fill cols (unsorted)."""
+def _batch_sizes(order, indptr, indices, n_nodes, cap):
+    """Cut `order` into runs (batches) of at most 32 points whose union node set stays ≤ cap:
+    (batch_ptr into order, nodes per batch)."""
+    m = len(order)
+    loc = np.full(n_nodes, -1, np.int64)
+    ptr = np.empty(m + 1, np.int64)
+    size = np.empty(m, np.int64)
+    nb = 0
+    k = 0
+    ptr[0] = 0
+    while k < m:
+        s0 = k
+        nS = 0
+        while k < m and k - s0 < 32:
+            q = order[k]
+            new = 0
+            for t in range(indptr[q], indptr[q + 1]):
+                if loc[indices[t]] != nb:
+                    new += 1
+            if k > s0 and nS + new > cap:
+                break
+            for t in range(indptr[q], indptr[q + 1]):
+                if loc[indices[t]] != nb:
+                    loc[indices[t]] = nb
+                    nS += 1
+            k += 1
+        size[nb] = nS
+        nb += 1
+        ptr[nb] = k
+    return ptr[:nb + 1].copy(), size[:nb].copy()
+
+
+@njit(cache=True, nogil=True)
+def _batch_masks(order, indptr, indices, n_nodes, batch_ptr, node_ptr, nodes, masks):
+    """nodes[node_ptr[s]:node_ptr[s+1]] the union nodes of batch s; masks[e] the bit set (over
+    that list) of the nodes sharing a point of batch s with node nodes[e]."""
+    W = masks.shape[1]
+    loc = np.full(n_nodes, -1, np.int64)
+    pm = np.empty(W, np.uint64)
+    for s in range(len(batch_ptr) - 1):
+        base = node_ptr[s]
+        nS = 0
+        for k in range(batch_ptr[s], batch_ptr[s + 1]):
+            q = order[k]
+            for t in range(indptr[q], indptr[q + 1]):
+                a = indices[t]
+                if loc[a] < 0:
+                    loc[a] = nS
+                    nodes[base + nS] = a
+                    nS += 1
+            pm[:] = 0
+            for t in range(indptr[q], indptr[q + 1]):
+                j = loc[indices[t]]
+                pm[j >> 6] |= np.uint64(1) << np.uint64(j & 63)
+            for t in range(indptr[q], indptr[q + 1]):
+                e = base + loc[indices[t]]
+                for w in range(W):
+                    masks[e, w] |= pm[w]
+        for j in range(nS):
+            loc[nodes[base + j]] = -1
+
+
+@njit(cache=True, nogil=True)
+def _pattern_rows(entry_ptr, entries, batch_of, node_ptr, nodes, masks, a0, a1, row_ptr,
+                  cols, count_only, row_len):
+    """Rows a0..a1 of the node pattern from the batch bit sets: count (row_len[a+1]) or fill
+    cols (unsorted)."""
     mark = np.full(len(row_len) - 1, -1, np.int64)
+    W = masks.shape[1]
     for a in range(a0, a1):
         cnt = 0
         base = 0 if count_only else row_ptr[a]
-        for s in range(tptr[a], tptr[a + 1]):
-            q = tpts[s]
-            for t in range(indptr[q], indptr[q + 1]):
-                b = indices[t]
-                if mark[b] != a:
-                    mark[b] = a
-                    if not count_only:
-                        cols[base + cnt] = b
-                    cnt += 1
+        for i in range(entry_ptr[a], entry_ptr[a + 1]):
+            e = entries[i]
+            s = batch_of[e]
+            n0 = node_ptr[s]
+            for w in range(W):
+                bits = masks[e, w]
+                j = 0
+                while bits != 0:
+                    if bits & np.uint64(1):
+                        b = nodes[n0 + 64 * w + j]
+                        if mark[b] != a:
+                            mark[b] = a
+                            if not count_only:
+                                cols[base + cnt] = b
+                            cnt += 1
+                    bits >>= np.uint64(1)
+                    j += 1
         if count_only:
             row_len[a + 1] = cnt
 
 
-def node_sparsity_pattern(indptr: np.ndarray, indices: np.ndarray,
-                          n_nodes: int) -> tuple[np.ndarray, np.ndarray]:
-    """(row_ptr (N+1,), cols) sorted CSR pattern of nodes sharing at least one point."""
+def node_sparsity_pattern(indptr: np.ndarray, indices: np.ndarray, n_nodes: int,
+                          order: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """(row_ptr (N+1,), cols) sorted CSR pattern of nodes sharing at least one point.
+
+    The points (in ``order``, best with neighbours adjacent: the plan's order) are cut into
+    batches of at most 32 whose union node set L_s stays within 3/2 of the largest support; for
+    each node a of a batch the nodes it shares a point with are one bit set over L_s (the OR of
+    its points' supports). Row a is the union of its bit sets over the batches holding it:
+    about |L_s| visits per batch instead of Σ_{q∋a} |supp q| (13x fewer on the hemisphere).
+    """
     m = len(indptr) - 1
-    inc = csr_matrix((np.ones(len(indices)), indices, indptr), shape=(m, n_nodes)).tocsc()
-    tptr, tpts = inc.indptr.astype(np.int64), inc.indices.astype(np.int64)
+    indptr, indices = np.asarray(indptr, np.int64), np.asarray(indices, np.int64)
+    order = np.arange(m, dtype=np.int64) if order is None else np.asarray(order, np.int64)
+    nmax = int(np.diff(indptr).max(initial=1))
+    cap = max(1, (3 * nmax) // 2)
+    batch_ptr, size = _batch_sizes(order, indptr, indices, np.int64(n_nodes), np.int64(cap))
+    node_ptr = np.concatenate([[0], np.cumsum(size)]).astype(np.int64)
+    nodes = np.empty(node_ptr[-1], np.int64)
+    masks = np.zeros((node_ptr[-1], (cap + 63) // 64), np.uint64)
+    _batch_masks(order, indptr, indices, np.int64(n_nodes), batch_ptr, node_ptr, nodes, masks)
+    batch_of = np.repeat(np.arange(len(size), dtype=np.int64), size)
+    entries = np.argsort(nodes, kind="stable").astype(np.int64)
+    entry_ptr = np.concatenate([[0], np.cumsum(np.bincount(nodes, minlength=n_nodes))]
+                               ).astype(np.int64)
     nc = n_threads(n_nodes)
     b = np.linspace(0, n_nodes, nc + 1).astype(np.int64)
     ranges = list(zip(b[:-1], b[1:]))
     row_len = np.zeros(n_nodes + 1, np.int64)
     empty = np.empty(0, np.int64)
-    run_threads(lambda a0, a1: _pattern_rows(indptr, indices, tptr, tpts, a0, a1, empty, empty,
-                                             True, row_len), ranges)
+    tables = (entry_ptr, entries, batch_of, node_ptr, nodes, masks)
+    run_threads(lambda a0, a1: _pattern_rows(*tables, a0, a1, empty, empty, True, row_len),
+                ranges)
     row_ptr = np.cumsum(row_len)
     cols = np.empty(row_ptr[-1], np.int64)
-    run_threads(lambda a0, a1: _pattern_rows(indptr, indices, tptr, tpts, a0, a1, row_ptr, cols,
-                                             False, row_len), ranges)
+    run_threads(lambda a0, a1: _pattern_rows(*tables, a0, a1, row_ptr, cols, False, row_len),
+                ranges)
     pattern = csr_matrix((np.ones(len(cols), np.int8), cols, row_ptr), shape=(n_nodes, n_nodes))
     pattern.has_sorted_indices = False
     pattern.sort_indices()  # in place, C++
@@ -122,7 +215,6 @@ def _cut_blocks(order, indptr, indices, group, n_nodes, cap):
 def make_plan(indptr, indices, basis, group, n_nodes: int,
               cap: int = DEFAULT_BLOCK_CAP) -> AssemblyPlan:
     """Pattern, point order (group, nearest node), blocks and per-thread block ranges."""
-    row_ptr, cols = node_sparsity_pattern(indptr, indices, n_nodes)
     m = len(indptr) - 1
     counts = np.diff(indptr)
     if m and counts.min() > 0:
@@ -130,6 +222,7 @@ def make_plan(indptr, indices, basis, group, n_nodes: int,
     else:
         nearest = np.zeros(m, np.int64)
     order = np.lexsort((nearest, group)).astype(np.int64)
+    row_ptr, cols = node_sparsity_pattern(indptr, indices, n_nodes, order)
     cap = max(int(cap), 2 * int(counts.max(initial=1)))
     block_ptr = _cut_blocks(order, indptr, indices, group, np.int64(n_nodes), np.int64(cap))
     work = np.add.reduceat((counts[order] ** 2).astype(np.float64), block_ptr[:-1]) if m else \

@@ -1,4 +1,6 @@
 import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy.sparse import csr_matrix
 
 from pointatlas_kit.assembly_plan import make_plan, node_sparsity_pattern
@@ -28,3 +30,23 @@ def test_small_blocks_give_same_matrix(cylinder_patch, material):
     assert len(q2._plan.block_ptr) - 1 > len(q.assembly_plan().block_ptr) - 1
     K2 = tangent_stiffness(q2, material, U)
     assert abs(K - K2).max() < 1e-12 * abs(K).max()
+
+
+@settings(max_examples=40, deadline=None)
+@given(n_nodes=st.integers(1, 150), n_points=st.integers(0, 120),
+       support=st.integers(1, 70), seed=st.integers(0, 2**32 - 1), shuffle=st.booleans())
+def test_batched_pattern_equals_incidence_product_for_any_supports_and_order(
+        n_nodes, n_points, support, seed, shuffle):
+    """The bit-set pattern (batches of points, unions over 64-bit words) is exactly BᵀB for
+    supports of any size, overlap and order, including nodes no point touches."""
+    rng = np.random.default_rng(seed)
+    sizes = rng.integers(1, min(support, n_nodes) + 1, n_points)
+    indptr = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+    indices = np.concatenate([rng.choice(n_nodes, k, replace=False) for k in sizes]
+                             ).astype(np.int64) if n_points else np.empty(0, np.int64)
+    order = rng.permutation(n_points) if shuffle else None
+    row_ptr, cols = node_sparsity_pattern(indptr, indices, n_nodes, order)
+    B = csr_matrix((np.ones(len(indices)), indices, indptr), (n_points, n_nodes))
+    S = (B.T @ B).tocsr()
+    S.sort_indices()
+    assert np.array_equal(row_ptr, S.indptr) and np.array_equal(cols, S.indices)

@@ -39,6 +39,8 @@ from scipy.sparse import csc_matrix, csr_matrix
 
 from pointatlas.errors import ConfigError, InputError
 
+from .symmetric_upper import symmetric_upper
+
 #: The backends, in the order of the table above; ``auto`` and ``direct`` are names for two.
 BACKENDS = ("superlu", "pardiso", "cg_amg", "cg_ilu")
 CHOICES = (*BACKENDS, "auto", "direct")
@@ -163,11 +165,10 @@ class PardisoFactorization(Factorization):
         n = self.matrix.shape[0]
         if n == 0 or self.matrix.shape[1] != n:
             raise InputError(f"pardiso needs a non-empty square matrix, got {A.shape}.")
-        asym = abs(self.matrix - self.matrix.T).max() if self.matrix.nnz else 0.0
-        if asym > 1e-10 * max(abs(self.matrix).max(), 1e-300):
+        asym, self.upper = symmetric_upper(self.matrix)
+        if asym > 1e-10 * max(abs(self.matrix.data).max(initial=0.0), 1e-300):
             raise InputError(f"pardiso (symmetric LDLᵀ) got a non-symmetric matrix "
                              f"(max |A − Aᵀ| = {asym:.3g}); use physics.solver=superlu.")
-        self.upper = _upper_with_diagonal(self.matrix)
         same = reuse is not None and getattr(reuse, "_solver", None) is not None and \
             np.array_equal(reuse.upper.indptr, self.upper.indptr) and \
             np.array_equal(reuse.upper.indices, self.upper.indices)
@@ -260,20 +261,6 @@ def _mkl_runtime_library() -> str | None:
         if os.path.isfile(path):
             return path
     return None
-
-
-def _upper_with_diagonal(A: csr_matrix) -> csr_matrix:
-    """The upper triangle of A in CSR with every diagonal entry stored (PARDISO's symmetric
-    format: explicit zeros on the diagonal where A has none)."""
-    from scipy.sparse import coo_matrix, triu
-
-    U = triu(A, format="coo")
-    n = A.shape[0]
-    idx = np.arange(n)
-    out = coo_matrix((np.r_[U.data, np.zeros(n)], (np.r_[U.row, idx], np.r_[U.col, idx])),
-                     shape=A.shape).tocsr()   # duplicates summed, explicit zeros kept
-    out.sort_indices()
-    return out
 
 
 class _ConjugateGradient(Factorization):

@@ -6,7 +6,7 @@ from pathlib import Path
 import pointatlas_solvers
 
 PACKAGE = Path(pointatlas_solvers.__file__).parent
-ALLOWED = ("numpy", "scipy", "pyamg", "pypardiso", "pointatlas", "__future__", "dataclasses",
+ALLOWED = ("numpy", "scipy", "numba", "pyamg", "pypardiso", "pointatlas", "__future__", "dataclasses",
            "typing", "time", "os", "importlib", "functools")
 
 

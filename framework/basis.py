@@ -56,13 +56,25 @@ class BasisFunctions:
         counts = np.diff(self.indptr)[rows]
         indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
         starts = self.indptr[rows]
-        flat = (np.repeat(starts - indptr[:-1], counts) + np.arange(indptr[-1])).astype(np.int64)
+        # runs of consecutive rows are contiguous in the flat arrays: copied as slices (memcpy)
+        # when there are few of them (a chart's kept quadrature points), else gathered
+        cut = np.flatnonzero(np.diff(rows) != 1) + 1 if len(rows) else np.zeros(0, np.int64)
+        if len(rows) and len(cut) + 1 <= max(1, len(rows) // 8):
+            first = rows[np.r_[0, cut]]
+            last = rows[np.r_[cut - 1, len(rows) - 1]]
+            spans = list(zip(self.indptr[first], self.indptr[last + 1]))
 
-        def pick(a):
-            return None if a is None else a[flat]
+            def pick(a):
+                return None if a is None else np.concatenate([a[s:e] for s, e in spans])
+        else:
+            flat = (np.repeat(starts - indptr[:-1], counts) + np.arange(indptr[-1])
+                    ).astype(np.int64)
+
+            def pick(a):
+                return None if a is None else a[flat]
 
         return BasisFunctions(
-            indptr=indptr, indices=self.indices[flat], values=self.values[flat],
+            indptr=indptr, indices=pick(self.indices), values=pick(self.values),
             gradients=pick(self.gradients), hessians=pick(self.hessians),
             outside=None if self.outside is None else self.outside[rows])
 

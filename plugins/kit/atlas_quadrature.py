@@ -16,6 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from numba import njit
 
 from pointatlas.errors import InputError
 
@@ -126,6 +127,22 @@ class AtlasQuadrature:
         return self._plan
 
 
+@njit(cache=True, nogil=True)
+def _pack_jets(values, gradients, hessians, out):
+    """out[t] = (p, p_,1, p_,2, p_,11, ½(p_,12 + p_,21), p_,22)[:out.shape[1]] row by row (one
+    pass over the rows of ``out`` instead of one strided pass per column)."""
+    ncol = out.shape[1]
+    for t in range(out.shape[0]):
+        out[t, 0] = values[t]
+        if ncol > 1:
+            out[t, 1] = gradients[t, 0]
+            out[t, 2] = gradients[t, 1]
+        if ncol > 3:
+            out[t, 3] = hessians[t, 0, 0]
+            out[t, 4] = 0.5 * (hessians[t, 0, 1] + hessians[t, 1, 0])
+            out[t, 5] = hessians[t, 1, 1]
+
+
 def atlas_quadrature(atlas, order: int, release_basis: bool = False) -> AtlasQuadrature:
     """The :class:`AtlasQuadrature` of a built atlas (``build_quadrature(keep_basis=True)``),
     with basis columns up to chart derivative ``order``.
@@ -159,14 +176,9 @@ def atlas_quadrature(atlas, order: int, release_basis: bool = False) -> AtlasQua
         p1, z1 = p0 + len(c.weights), z0 + len(b.indices)
         indptr[p0 + 1:p1 + 1] = np.asarray(b.indptr[1:], np.int64) + z0
         indices[z0:z1] = b.indices
-        basis[z0:z1, 0] = b.values
-        if order >= 1:
-            basis[z0:z1, 1:3] = b.gradients[:, :2]
+        _pack_jets(b.values, b.gradients if order >= 1 else np.zeros((0, 2)),
+                   b.hessians if order >= 2 else np.zeros((0, 2, 2)), basis[z0:z1])
         if order >= 2:
-            H = b.hessians
-            basis[z0:z1, 3] = H[:, 0, 0]
-            basis[z0:z1, 4] = 0.5 * (H[:, 0, 1] + H[:, 1, 0])
-            basis[z0:z1, 5] = H[:, 1, 1]
             second[p0:p1] = c.second
         weights[p0:p1], chart[p0:p1] = c.weights, k
         positions[p0:p1], tangents[p0:p1] = c.positions, c.tangents

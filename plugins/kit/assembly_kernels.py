@@ -9,9 +9,10 @@ With the jet tables of :class:`.fields.FieldLayout` (``col[r]`` the basis column
 
 evaluated, for the tangent, through G[a, I, s] = w_q Σ_{r: dof[r]=I} p_a,col[r] H_q[r, s],
 so a node pair costs B·n_jet operations; with one field the products of a batch of
-neighbouring points are one matrix product (BLAS, all node pairs of the batch). The tangent of a point block is accumulated in a
-dense (|L|, |L|, B, B) array over the block's node set L (several fields: pairs a ≤ b, K
-being symmetric) and flushed once into the block-CSR data of the plan (:mod:`.assembly_plan`).
+neighbouring points are one matrix product (BLAS, all node pairs of the batch). The tangent
+of a point block is accumulated in a dense (|L|, |L|, B, B) array over the block's node set
+L (several fields: pairs a ≤ b, K being symmetric) and flushed once into the block-CSR data
+of the plan (:mod:`.assembly_plan`).
 """
 from __future__ import annotations
 
@@ -89,33 +90,34 @@ def _tangent_blocks(blk0, blk1, order, block_ptr, first, indptr, indices, basis,
             _one_field_batches(block_ptr[blk], block_ptr[blk + 1], first, order, indptr,
                                indices, basis, weights, H, fcol[0], fncol[0], B, gl, nL,
                                Kloc)
-        for k in range(block_ptr[blk], block_ptr[blk + 1] if nf > 1 else 0):
-            q = order[k]
-            h = k - first
-            t0 = indptr[q]
-            n = indptr[q + 1] - t0
-            w = weights[q]
-            G = np.zeros((n, B, n_jet))
-            for a in range(n):
-                for r in range(n_jet):
-                    pw = w * basis[t0 + a, col[r]]
-                    I = dof[r]
-                    for s in range(n_jet):
-                        G[a, I, s] += pw * H[h, r, s]
-            for a in range(n):
-                la = gl[indices[t0 + a]]
-                for b in range(a, n):
-                    lb = gl[indices[t0 + b]]
-                    blkv[:, :] = 0.0
-                    for s in range(n_jet):
-                        c = basis[t0 + b, col[s]]
-                        J = dof[s]
+        else:
+            for k in range(block_ptr[blk], block_ptr[blk + 1]):
+                q = order[k]
+                h = k - first
+                t0 = indptr[q]
+                n = indptr[q + 1] - t0
+                w = weights[q]
+                G = np.zeros((n, B, n_jet))
+                for a in range(n):
+                    for r in range(n_jet):
+                        pw = w * basis[t0 + a, col[r]]
+                        I = dof[r]
+                        for s in range(n_jet):
+                            G[a, I, s] += pw * H[h, r, s]
+                for a in range(n):
+                    la = gl[indices[t0 + a]]
+                    for b in range(a, n):
+                        lb = gl[indices[t0 + b]]
+                        blkv[:, :] = 0.0
+                        for s in range(n_jet):
+                            c = basis[t0 + b, col[s]]
+                            J = dof[s]
+                            for I in range(B):
+                                blkv[I, J] += G[a, I, s] * c
+                        same = b != a and lb == la
                         for I in range(B):
-                            blkv[I, J] += G[a, I, s] * c
-                    same = b != a and lb == la
-                    for I in range(B):
-                        for J in range(B):
-                            Kloc[la, lb, I, J] += blkv[I, J] + (blkv[J, I] if same else 0.0)
+                            for J in range(B):
+                                Kloc[la, lb, I, J] += blkv[I, J] + (blkv[J, I] if same else 0.0)
         for i in range(nL):  # flush (several fields: K_ij = Kloc_ij + Kloc_jiᵀ, i ≠ j)
             A = nodes[i]
             for p in range(row_ptr[A], row_ptr[A + 1]):

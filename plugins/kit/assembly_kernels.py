@@ -19,6 +19,8 @@ from __future__ import annotations
 import numpy as np
 from numba import literally, njit
 
+from .assembly_plan import grow_batch
+
 
 @njit(cache=True, nogil=True)
 def jets_at(points, indptr, indices, basis, U, col, dof, out):
@@ -70,6 +72,8 @@ def _tangent_blocks(blk0, blk1, order, block_ptr, first, indptr, indices, basis,
                     data):
     nf = len(fcol)
     gl = np.full(n_nodes, -1, np.int64)  # global node -> position in the block's node list
+    sub = np.full(n_nodes, -1, np.int64)     # global node -> position in a batch (grow_batch)
+    snodes = np.empty(n_nodes, np.int64)
     for blk in range(blk0, blk1):
         count = 0
         for k in range(block_ptr[blk], block_ptr[blk + 1]):
@@ -88,8 +92,8 @@ def _tangent_blocks(blk0, blk1, order, block_ptr, first, indptr, indices, basis,
         blkv = np.empty((B, B))
         if nf == 1:
             _one_field_batches(block_ptr[blk], block_ptr[blk + 1], first, order, indptr,
-                               indices, basis, weights, H, fcol[0], fncol[0], B, gl, nL,
-                               Kloc)
+                               indices, basis, weights, H, fcol[0], fncol[0], B, gl, sub,
+                               snodes, Kloc)
         else:
             for k in range(block_ptr[blk], block_ptr[blk + 1]):
                 q = order[k]
@@ -134,9 +138,10 @@ def _tangent_blocks(blk0, blk1, order, block_ptr, first, indptr, indices, basis,
 
 @njit(cache=True, nogil=True)
 def _one_field_batches(k0, k1, first, order, indptr, indices, basis, weights, H, c0, nc, B,
-                       gl, nL, Kloc):
+                       gl, sub, snodes, Kloc):
     """Kloc += the tangent of the points order[k0:k1] of a single-field layout, in batches of
-    consecutive points whose supports overlap (the plan orders points by nearest node).
+    consecutive points whose supports overlap (the plan orders points by nearest node; the
+    batches are :func:`.assembly_plan.grow_batch`'s; ``sub``/``snodes`` its scratch arrays).
 
     For a batch S with union node set L_S, K_ab[i, j] = Σ_{q∈S} Σ_kk p_b,kk(q) G[(q, kk),
     (a, i, j)], G[(q, kk), (a, i, j)] = w_q Σ_k' p_a,k'(q) H_q[k'B + i, kk B + j]: one matrix
@@ -150,28 +155,11 @@ def _one_field_batches(k0, k1, first, order, indptr, indices, basis, weights, H,
         nmax = max(nmax, indptr[order[k] + 1] - indptr[order[k]])
     cap = (3 * nmax) // 2
     BB = B * B
-    sub = np.full(nL, -1, np.int64)   # block-local node -> batch-local node
-    snodes = np.empty(nL, np.int64)
     Hr = np.empty((nc, nc * BB))
     k = k0
     while k < k1:
         s0 = k
-        nS = 0
-        while k < k1 and k - s0 < 32:
-            q = order[k]
-            new = 0
-            for t in range(indptr[q], indptr[q + 1]):
-                if sub[gl[indices[t]]] < 0:
-                    new += 1
-            if k > s0 and nS + new > cap:
-                break
-            for t in range(indptr[q], indptr[q + 1]):
-                la = gl[indices[t]]
-                if sub[la] < 0:
-                    sub[la] = nS
-                    snodes[nS] = la
-                    nS += 1
-            k += 1
+        k, nS = grow_batch(order, k, k1, indptr, indices, cap, sub, snodes)
         mS = k - s0
         PhiS = np.zeros((nS, nc * mS))
         G = np.zeros((nc * mS, nS * BB))
@@ -192,18 +180,17 @@ def _one_field_batches(k0, k1, first, order, indptr, indices, basis, weights, H,
                             Hr[kp, kk * BB + i * B + jj] = w * H[h, kp * B + i, kk * B + jj]
             T = np.dot(Phi, Hr)  # T[a, (kk, i, j)] = G[(q, kk), (a, i, j)]
             for a in range(n):
-                sa = sub[gl[indices[t0 + a]]]
+                sa = sub[indices[t0 + a]]
                 for kk in range(nc):
                     PhiS[sa, j * nc + kk] += Phi[a, kk]
                     for r in range(BB):
                         G[j * nc + kk, sa * BB + r] += T[a, kk * BB + r]
         P = np.dot(PhiS, G)  # P[b, (a, i, j)] = K_ab[i, j]
         for a in range(nS):
-            la = snodes[a]
+            la = gl[snodes[a]]
             for b in range(nS):
-                lb = snodes[b]
+                lb = gl[snodes[b]]
                 for i in range(B):
                     for j in range(B):
                         Kloc[la, lb, i, j] += P[b, a * BB + i * B + j]
-        for a in range(nS):
-            sub[snodes[a]] = -1
+        sub[snodes[:nS]] = -1

@@ -47,33 +47,50 @@ def n_threads(n_items: int) -> int:
     return max(1, min(numba.get_num_threads(), n_items))
 
 
+BATCH_POINTS = 32   # at most this many points per batch (grow_batch)
+
+
+@njit(cache=True, nogil=True)
+def grow_batch(order, k, k1, indptr, indices, cap, pos, nodes):
+    """A batch of consecutive points order[k:end] (end ≤ k1): at most BATCH_POINTS points
+    whose union node set stays ≤ cap (the first point always joins). Returns (end, nS):
+    nodes[:nS] the union, pos[node] its place in it. pos must be −1 on entry for every node;
+    the caller resets pos[nodes[:nS]] = −1. Used by the pattern below and by the tangent
+    kernel (:mod:`.assembly_kernels`), so both cut the points alike."""
+    s0 = k
+    nS = 0
+    while k < k1 and k - s0 < BATCH_POINTS:
+        q = order[k]
+        new = 0
+        for t in range(indptr[q], indptr[q + 1]):
+            if pos[indices[t]] < 0:
+                new += 1
+        if k > s0 and nS + new > cap:
+            break
+        for t in range(indptr[q], indptr[q + 1]):
+            a = indices[t]
+            if pos[a] < 0:
+                pos[a] = nS
+                nodes[nS] = a
+                nS += 1
+        k += 1
+    return k, nS
+
+
 @njit(cache=True, nogil=True)
 def _batch_sizes(order, indptr, indices, n_nodes, cap):
-    """Cut `order` into runs (batches) of at most 32 points whose union node set stays ≤ cap:
-    (batch_ptr into order, nodes per batch)."""
+    """The batches of `order` (grow_batch): (batch_ptr into order, nodes per batch)."""
     m = len(order)
-    loc = np.full(n_nodes, -1, np.int64)
+    pos = np.full(n_nodes, -1, np.int64)
+    union = np.empty(n_nodes, np.int64)
     ptr = np.empty(m + 1, np.int64)
     size = np.empty(m, np.int64)
     nb = 0
     k = 0
     ptr[0] = 0
     while k < m:
-        s0 = k
-        nS = 0
-        while k < m and k - s0 < 32:
-            q = order[k]
-            new = 0
-            for t in range(indptr[q], indptr[q + 1]):
-                if loc[indices[t]] != nb:
-                    new += 1
-            if k > s0 and nS + new > cap:
-                break
-            for t in range(indptr[q], indptr[q + 1]):
-                if loc[indices[t]] != nb:
-                    loc[indices[t]] = nb
-                    nS += 1
-            k += 1
+        k, nS = grow_batch(order, k, m, indptr, indices, cap, pos, union)
+        pos[union[:nS]] = -1
         size[nb] = nS
         nb += 1
         ptr[nb] = k
@@ -81,33 +98,27 @@ def _batch_sizes(order, indptr, indices, n_nodes, cap):
 
 
 @njit(cache=True, nogil=True)
-def _batch_masks(order, indptr, indices, n_nodes, batch_ptr, node_ptr, nodes, masks):
+def _batch_masks(order, indptr, indices, n_nodes, batch_ptr, node_ptr, nodes, masks, cap):
     """nodes[node_ptr[s]:node_ptr[s+1]] the union nodes of batch s; masks[e] the bit set (over
     that list) of the nodes sharing a point of batch s with node nodes[e]."""
     W = masks.shape[1]
-    loc = np.full(n_nodes, -1, np.int64)
+    pos = np.full(n_nodes, -1, np.int64)
     pm = np.empty(W, np.uint64)
     for s in range(len(batch_ptr) - 1):
         base = node_ptr[s]
-        nS = 0
+        _, nS = grow_batch(order, batch_ptr[s], batch_ptr[s + 1], indptr, indices, cap, pos,
+                           nodes[base:node_ptr[s + 1]])
         for k in range(batch_ptr[s], batch_ptr[s + 1]):
             q = order[k]
-            for t in range(indptr[q], indptr[q + 1]):
-                a = indices[t]
-                if loc[a] < 0:
-                    loc[a] = nS
-                    nodes[base + nS] = a
-                    nS += 1
             pm[:] = 0
             for t in range(indptr[q], indptr[q + 1]):
-                j = loc[indices[t]]
+                j = pos[indices[t]]
                 pm[j >> 6] |= np.uint64(1) << np.uint64(j & 63)
             for t in range(indptr[q], indptr[q + 1]):
-                e = base + loc[indices[t]]
+                e = base + pos[indices[t]]
                 for w in range(W):
                     masks[e, w] |= pm[w]
-        for j in range(nS):
-            loc[nodes[base + j]] = -1
+        pos[nodes[base:base + nS]] = -1
 
 
 @njit(cache=True, nogil=True)
@@ -146,7 +157,7 @@ def node_sparsity_pattern(indptr: np.ndarray, indices: np.ndarray, n_nodes: int,
     """(row_ptr (N+1,), cols) sorted CSR pattern of nodes sharing at least one point.
 
     The points (in ``order``, best with neighbours adjacent: the plan's order) are cut into
-    batches of at most 32 whose union node set L_s stays within 3/2 of the largest support; for
+    batches (:func:`grow_batch`) of at most 32 whose union node set L_s stays within 3/2 of the largest support; for
     each node a of a batch the nodes it shares a point with are one bit set over L_s (the OR of
     its points' supports). Row a is the union of its bit sets over the batches holding it:
     about |L_s| visits per batch instead of Σ_{q∋a} |supp q| (13x fewer on the hemisphere).
@@ -160,7 +171,8 @@ def node_sparsity_pattern(indptr: np.ndarray, indices: np.ndarray, n_nodes: int,
     node_ptr = np.concatenate([[0], np.cumsum(size)]).astype(np.int64)
     nodes = np.empty(node_ptr[-1], np.int64)
     masks = np.zeros((node_ptr[-1], (cap + 63) // 64), np.uint64)
-    _batch_masks(order, indptr, indices, np.int64(n_nodes), batch_ptr, node_ptr, nodes, masks)
+    _batch_masks(order, indptr, indices, np.int64(n_nodes), batch_ptr, node_ptr, nodes, masks,
+                 np.int64(cap))
     batch_of = np.repeat(np.arange(len(size), dtype=np.int64), size)
     entries = np.argsort(nodes, kind="stable").astype(np.int64)
     entry_ptr = np.concatenate([[0], np.cumsum(np.bincount(nodes, minlength=n_nodes))]

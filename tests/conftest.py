@@ -14,6 +14,11 @@ import pytest
 BIN = Path(sys.executable).parent
 
 
+def _cli_env() -> dict:
+    """The environment the console scripts run with in the tests."""
+    return {**os.environ, "MPLBACKEND": "Agg", "HYDRA_FULL_ERROR": "0", "PYTHONWARNINGS": "ignore"}
+
+
 def _run_cli(cmd: str, *args: str, cwd: Path, timeout: float = 600) -> subprocess.CompletedProcess:
     """Run one of the project's console scripts in a new process, as a user would. Every
     results file a successful ``pointatlas`` run writes is checked for CF units (UDUNITS
@@ -26,7 +31,7 @@ def _run_cli(cmd: str, *args: str, cwd: Path, timeout: float = 600) -> subproces
     beyond the project's own variables."""
     import time
 
-    env = {**os.environ, "MPLBACKEND": "Agg", "HYDRA_FULL_ERROR": "0", "PYTHONWARNINGS": "ignore"}
+    env = _cli_env()
     started = time.time()
     if _ZYGOTE.usable(env):
         out = _ZYGOTE.run(cmd, args, cwd=cwd, env=env, timeout=timeout)
@@ -52,8 +57,7 @@ class _Zygote:
 
     def __init__(self):
         self.proc = None
-        self.base_env = {**os.environ, "MPLBACKEND": "Agg", "HYDRA_FULL_ERROR": "0",
-                         "PYTHONWARNINGS": "ignore"}
+        self.base_env = _cli_env()
         self.broken = os.environ.get("POINTATLAS_TEST_SUBPROCESS") == "1"
 
     def usable(self, env: dict) -> bool:

@@ -220,7 +220,9 @@ def _check_transform(est, X: np.ndarray, Y: np.ndarray, rtol: float, k: int = 20
 
 
 def check_approximant(cls: type, *, dim: int = 2, reproduces_linear: bool = False, **kwargs: Any) -> None:
-    """Partition of unity (and linear reproduction when claimed) at interior points."""
+    """Partition of unity, gradients summing to 0, non-negative values unless the class says
+    ``non_negative = False`` (moving least squares), and linear reproduction when claimed,
+    at interior points."""
     check_contract(cls)
     rng = np.random.default_rng(0)
     nodes = rng.random((150, dim))
@@ -230,7 +232,9 @@ def check_approximant(cls: type, *, dim: int = 2, reproduces_linear: bool = Fals
     rows = np.repeat(np.arange(len(points)), np.diff(basis.indptr))
     total = np.bincount(rows, weights=basis.values, minlength=len(points))
     np.testing.assert_allclose(total, 1.0, atol=1e-8, err_msg="basis functions must sum to 1")
-    assert (basis.values >= -1e-14).all(), "basis function values must be non-negative"
+    if getattr(cls, "non_negative", True):
+        assert (basis.values >= -1e-14).all(), ("basis function values must be non-negative "
+                                                "(or the class declares non_negative = False)")
     assert basis.gradients is not None and basis.gradients.shape == (len(basis.values), dim)
     gsum = np.zeros((len(points), dim))
     np.add.at(gsum, rows, basis.gradients)

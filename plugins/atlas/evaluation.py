@@ -54,6 +54,10 @@ def basis_at(atlas, chart: np.ndarray, xi: np.ndarray, order: int = 1) -> BasisF
         b = c.approximant.evaluate(xi[sel], order=order)
         if b.outside is not None and b.outside.any():
             i = sel[np.flatnonzero(b.outside)[0]]
+            why = getattr(c.approximant, "refusal", lambda j: None)(int(np.flatnonzero(
+                b.outside)[0]))
+            if why:
+                raise InputError(f"point {i} (ξ = {xi[i].tolist()}) of chart {k}: {why}")
             raise InputError(f"point {i} (ξ = {xi[i].tolist()}) lies outside chart {k}'s domain; "
                              "evaluate at points inside the sampled surface.")
         parts.append(b.renumbered(c.node_index))

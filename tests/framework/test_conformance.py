@@ -14,7 +14,7 @@ SMALL = {
     ("embedder", "nlie"): {"n_stress_neighbors": 15, "max_iter": 10, "lbfgs_max_iter": 50},
     ("physics", "kirchhoff_love_fracture"): {"length_scale": 0.15},   # required, no default
 }
-LINEAR = {("approximant", "lme")}
+LINEAR = {("approximant", "lme"), ("approximant", "mls")}
 # transform of a training point gives back its embedding exactly (to rounding: at most 1.0e-14
 # of the spread measured) for pca, isomap and nlie, under check_embedder's default 1e-8. LLE and
 # MLLE reconstruct a training point from its k nearest *other* training points, by design

@@ -119,12 +119,22 @@ class LocalMaxEnt(RebuildsCellLists):
 
     def evaluate(self, points, order: int = 0) -> BasisFunctions:
         """p_a at the (m, d) points, with gradients (order ≥ 1) and Hessians (order 2)."""
+        x, basis, status = self._evaluate_flagged(points, order)
+        bad = basis.outside
+        if bad is not None and self.outside == "error":
+            i = int(np.flatnonzero(bad)[0])
+            raise InputError(self._outside_message(i, x[i], int(bad.sum()), status[i]))
+        return basis
+
+    def _evaluate_flagged(self, points, order: int):
+        """(x, basis with the points outside the domain flagged (never raised), status)."""
         if not hasattr(self, "nodes_"):
-            raise InputError("LocalMaxEnt.evaluate called before fit; call fit(nodes) first.")
+            raise InputError(f"{type(self).__name__}.evaluate called before fit; call "
+                             "fit(nodes) first.")
         validate_parameters(self)
-        order = check_order(order, 2, plugin="LocalMaxEnt")
+        order = check_order(order, 2, plugin=type(self).__name__)
         d = self.nodes_.shape[1]
-        x = check_points(points, d, plugin="LocalMaxEnt")
+        x = check_points(points, d, plugin=type(self).__name__)
         indptr, arrays, status = self._solve(self.grid_.cells(x), order)
         bad = status != K.OK
         if bad.any():
@@ -136,13 +146,10 @@ class LocalMaxEnt(RebuildsCellLists):
             grads, hess = self._second_order(x, bad, indptr, indices, values, grads, hess,
                                              order, fit)
         if not bad.any():
-            return BasisFunctions(indptr, indices, values, grads, hess, None)
-        if self.outside == "error":
-            i = int(np.flatnonzero(bad)[0])
-            raise InputError(self._outside_message(i, x[i], int(bad.sum()), status[i]))
+            return x, BasisFunctions(indptr, indices, values, grads, hess, None), status
         indptr, (indices, values, grads, hess) = compact_rows(
             indptr, ~bad, indices, values, grads, hess)
-        return BasisFunctions(indptr, indices, values, grads, hess, bad)
+        return x, BasisFunctions(indptr, indices, values, grads, hess, bad), status
 
     def _second_order(self, x, bad, indptr, indices, values, grads, hess, order, fit):
         """Replace, in place on the rows of the points where LME exists, the Hessians

@@ -194,7 +194,8 @@ class MovingLeastSquares(LocalMaxEnt):
     those of the fit. A point whose nodes do not determine a polynomial of the degree (a
     singular moment matrix, or a Lebesgue constant above :data:`MAX_LEBESGUE`) is refused
     (``outside='error'``) or flagged with the points outside (``outside='flag'``).
-    ``lebesgue_`` holds Λ(x) of the last evaluation (inf where singular).
+    ``lebesgue_`` holds Λ(x) of the last evaluation (inf where singular), ``refused_`` the
+    rows the fit refused (inside LME's domain): diagnostics of one evaluation at a time.
     """
 
     @dataclass
@@ -225,13 +226,7 @@ class MovingLeastSquares(LocalMaxEnt):
     def evaluate(self, points, order: int = 0) -> BasisFunctions:
         """φ_a at the (m, d) points, with exact gradients (order ≥ 1) and Hessians (2)."""
         order = check_order(order, 2, plugin="MovingLeastSquares")
-        flag = self.outside
-        self.outside = "flag"
-        try:
-            lme = LocalMaxEnt.evaluate(self, points, 0)
-        finally:
-            self.outside = flag
-        x = np.ascontiguousarray(points, dtype=np.float64)
+        x, lme, status = self._evaluate_flagged(points, 0)  # LME's supports and domain
         indptr, indices = lme.indptr, lme.indices
         nnz, d = len(indices), x.shape[1]
         values = np.empty(nnz)
@@ -253,7 +248,7 @@ class MovingLeastSquares(LocalMaxEnt):
         outside |= singular
         if outside.any() and self.outside == "error":
             i = int(np.flatnonzero(outside)[0])
-            raise InputError(self._outside_message(i, x[i], int(outside.sum()), -1))
+            raise InputError(self._outside_message(i, x[i], int(outside.sum()), status[i]))
         arrays = (indices, values, grads if order >= 1 else None, hess if order >= 2 else None)
         if not outside.any():
             return BasisFunctions(indptr, *arrays, None)

@@ -15,6 +15,8 @@ conforming Argyris element (ElementTriArgyris, quintic C¹ triangles) on the sam
   (the same with x ↔ y). Meshes: uniform n×n squares cut in two (``regular``), and the
   Delaunay triangulation of the jittered point cloud (``jittered``; meshing is timed).
 * pointatlas: the experiment's physics settings read from experiments/shell_plate.yaml,
+  with the default LME charts and, on the jittered clouds, also the cubic moving
+  least-squares basis with exact Hessians (``approximant=mls approximant.degree=3``),
   the square_plate source at a sequence of ``n_points``, ``sampling = structured`` and
   ``random`` (the grid jittered by up to 0.3 spacing, edge points slide along their edge),
   the source RNG seeded as the CLI seeds it; one jittered run is repeated through the CLI
@@ -65,6 +67,9 @@ BENCHMARKS_CONVERGED = 0.0056122  # BENCHMARKS.md / thesis L1337, in F L²/D
 TARGETS = (1e-3, 2e-4)
 SEED = 0                        # the CLI's default run seed
 RICHARDSON_MAX_N = 32           # finest Argyris mesh in the extrapolation (roundoff)
+MLS = "pointatlas-mls3"         # pointatlas with approximant=mls approximant.degree=3
+COMPARISONS = ("pointatlas/Argyris, regular", "pointatlas/Argyris, jittered",
+               f"{MLS}/Argyris, jittered")
 
 
 def experiment():
@@ -160,17 +165,19 @@ def timed(fn):
 
 
 # --------------------------------------------------------------------------- pointatlas
-def pointatlas_deflection(cloud, settings):
+def pointatlas_deflection(cloud, settings, approximant: str = "lme", **options):
     """Centre deflection (along −z) of the shell_plate experiment on ``cloud``: build the
-    atlas and the model, solve, read the displacement (as ShellStudy does)."""
+    atlas and the model, solve, read the displacement (as ShellStudy does). ``approximant``
+    and ``options``: the chart basis (``approximant=mls approximant.degree=3`` on the
+    command line is ``"mls", degree=3``)."""
     a = AtlasSettings(markers_per_patch=SHELL_MARKERS_PER_PATCH)
 
     def make(family, name, **kw):
         return lambda: pointatlas.load_plugin(family, name)(**kw)
 
     model = build_model(cloud, settings, a, make("embedders", "pca", n_components=2),
-                        make("approximants", "lme", gamma=a.gamma_lme, tol=a.tol_lme,
-                             outside="flag"),
+                        make("approximants", approximant, gamma=a.gamma_lme, tol=a.tol_lme,
+                             outside="flag", **options),
                         make("approximants", "shepard", gamma=a.gamma_pu, tol=a.tol_pu,
                              outside="flag"))
     solve_linear(model, settings)
@@ -244,11 +251,15 @@ def main(out: Path, quick: bool) -> None:
             cloud = plate_cloud(n, sampling, plate["L"])
             pa_jobs.append(("pointatlas", kind, n, len(cloud.points),
                             lambda cloud=cloud: pointatlas_deflection(cloud, settings)))
+            if kind == "jittered":  # the same clouds on the cubic moving least-squares basis
+                pa_jobs.append((MLS, kind, n, len(cloud.points),
+                                lambda cloud=cloud: pointatlas_deflection(
+                                    cloud, settings, "mls", degree=3)))
     for job in (j for pair in zip_longest(fem_jobs, pa_jobs) for j in pair if j):
         method_, kind, size_, nodes_, solve_ = job
         (w_, dof_, free_), wall, cpu_, reps_ = timed(solve_)
         rows.append((method_, kind, size_, nodes_, dof_, free_, w_, wall, cpu_, reps_))
-        print(f"{method_:10s} {kind:8s} {nodes_:5d} nodes: {dof_:6d} DOF  w = {w_:.9f}  "
+        print(f"{method_:15s} {kind:8s} {nodes_:5d} nodes: {dof_:6d} DOF  w = {w_:.9f}  "
               f"{wall:7.3f} s wall, {cpu_:7.3f} s CPU", flush=True)
     rows.sort(key=lambda r: (r[0], r[1] != "regular", r[2]))
 
@@ -267,7 +278,7 @@ def main(out: Path, quick: bool) -> None:
     method, cloud_kind, size, nodes, dof, free, w, secs, cpu, reps = map(np.array, zip(*rows))
     err = (w - converged) / converged
     series = [("argyris", "regular"), ("argyris", "jittered"), ("pointatlas", "regular"),
-              ("pointatlas", "jittered")]
+              ("pointatlas", "jittered"), (MLS, "jittered")]
     need_dof = np.full((len(series), len(TARGETS)), np.nan)
     need_time, need_cpu = np.full_like(need_dof, np.nan), np.full_like(need_dof, np.nan)
     notes = []
@@ -278,9 +289,10 @@ def main(out: Path, quick: bool) -> None:
             need_cpu[i, j] = reach(dof[sel], cpu[sel], err[sel], tgt)[1]
             notes.append(f"{m} {c} at {tgt:g}: {note}")
     # pointatlas / Argyris (regular mesh; jittered cloud vs Argyris on its Delaunay mesh)
-    dof_ratio = need_dof[2:] / need_dof[:2]
-    time_ratio = need_time[2:] / need_time[:2]
-    cpu_ratio = need_cpu[2:] / need_cpu[:2]
+    ours, peer = [2, 3, 4], [0, 1, 1]
+    dof_ratio = need_dof[ours] / need_dof[peer]
+    time_ratio = need_time[ours] / need_time[peer]
+    cpu_ratio = need_cpu[ours] / need_cpu[peer]
     load1 = os.getloadavg()
 
     print(f"\nconverged centre deflection (Richardson, Argyris n = {fem[-3][2]}, {fem[-2][2]}, "
@@ -294,20 +306,20 @@ def main(out: Path, quick: bool) -> None:
               f"{(finest[6] - converged) / converged:+.3e}, the extrapolation predicts "
               f"{(fem[-1][6] - converged) / converged / (finest[2] / fem[-1][2]) ** order:+.3e}")
     print(f"errors below are against w = {converged:.8f} (this run's extrapolation)\n")
-    print(f"{'method':10s} {'cloud':8s} {'nodes':>6s} {'DOF':>7s} {'w':>12s} {'rel.err':>9s} "
+    print(f"{'method':15s} {'cloud':8s} {'nodes':>6s} {'DOF':>7s} {'w':>12s} {'rel.err':>9s} "
           f"{'wall/s':>8s} {'CPU/s':>8s} reps")
     for k in range(len(rows)):
-        print(f"{method[k]:10s} {cloud_kind[k]:8s} {nodes[k]:6d} {dof[k]:7d} {w[k]:12.8f} "
+        print(f"{method[k]:15s} {cloud_kind[k]:8s} {nodes[k]:6d} {dof[k]:7d} {w[k]:12.8f} "
               f"{err[k]:+9.2e} {secs[k]:8.3f} {cpu[k]:8.3f} {reps[k]}")
-    print(f"\n{'to reach':22s} " + "  ".join(
+    print(f"\n{'to reach':26s} " + "  ".join(
         f"{'DOF @' + format(t, 'g'):>11s} {'wall @' + format(t, 'g'):>12s} "
         f"{'CPU @' + format(t, 'g'):>11s}" for t in TARGETS))
     for i, (m, c) in enumerate(series):
-        print(f"{m + ' ' + c:22s} " + "  ".join(
+        print(f"{m + ' ' + c:26s} " + "  ".join(
             f"{need_dof[i, j]:11.0f} {need_time[i, j]:10.3f} s {need_cpu[i, j]:9.3f} s"
             for j in range(len(TARGETS))))
-    for i, c in enumerate(("regular", "jittered")):
-        print(f"pointatlas/Argyris, {c}: " + "; ".join(
+    for i, c in enumerate(COMPARISONS):
+        print(f"{c}: " + "; ".join(
             f"@{t:g}: DOF × {dof_ratio[i, j]:.2f}, wall × {time_ratio[i, j]:.1f}, "
             f"CPU × {cpu_ratio[i, j]:.1f}" for j, t in enumerate(TARGETS)))
     print("(issue 17 target: ≤ 2× DOF and ≤ 5× time at equal accuracy; nan: a series does not "
@@ -343,13 +355,13 @@ def main(out: Path, quick: bool) -> None:
          "cpu_needed": ((s_dim, "target"), need_cpu, {
              "long_name": "CPU time to reach the relative error (log–log interpolation)",
              "units": "s"}),
-         "cpu_ratio": (("cloud", "target"), cpu_ratio, {
+         "cpu_ratio": (("comparison", "target"), cpu_ratio, {
              "long_name": "pointatlas CPU time / Argyris CPU time at equal accuracy",
              "units": "1"}),
-         "dof_ratio": (("cloud", "target"), dof_ratio, {
+         "dof_ratio": (("comparison", "target"), dof_ratio, {
              "long_name": "pointatlas DOF / Argyris DOF at equal accuracy (target ≤ 2)",
              "units": "1"}),
-         "time_ratio": (("cloud", "target"), time_ratio, {
+         "time_ratio": (("comparison", "target"), time_ratio, {
              "long_name": "pointatlas time / Argyris time at equal accuracy (target ≤ 5)",
              "units": "1"}),
          "converged_deflection": ((), converged, {
@@ -364,8 +376,9 @@ def main(out: Path, quick: bool) -> None:
              "units": "1"})},
         coords={"run": (run_dim, np.arange(len(rows)), {"long_name": "run", "units": "1"}),
                 "method": (run_dim, method.astype(str), {"long_name": "method", "units": "1"}),
-                "cloud": ("cloud", ["regular", "jittered"], {"long_name": "point set / mesh",
-                                                             "units": "1"}),
+                "comparison": ("comparison", list(COMPARISONS), {
+                    "long_name": "pointatlas series / Argyris series on the same point set",
+                    "units": "1"}),
                 "cloud_kind": (run_dim, cloud_kind.astype(str), {
                     "long_name": "regular grid or jittered cloud", "units": "1"}),
                 "size": (run_dim, size, {"long_name": "mesh divisions n (regular Argyris) or "

@@ -107,8 +107,9 @@ class SurfacePDE:
                                    "units": "1"})
         if self.refinement:
             rows = []
+            own = getattr(ctx.plugin("source"), "n_points", None)
             for n in self.refinement:
-                if n == cloud.n_points:  # the run's own cloud (same source seed): solved above
+                if n == own == cloud.n_points:  # the run's own cloud (same seed): solved above
                     rows.append((n, int(ds["n_dof"]), l2, h1))
                 else:
                     with ctx.timed(f"solve_{n}"):

@@ -7,14 +7,14 @@ inside the convex hull of the nodes. Kernels and derivative formulas: :mod:`.lme
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import ClassVar, Optional
+from typing import ClassVar
 
 import numba
 import numpy as np
 from scipy.spatial import cKDTree
 
 from pointatlas.basis import BasisFunctions
-from pointatlas.constraints import Interval, Options, validate_parameters
+from pointatlas.constraints import Options, validate_parameters
 from pointatlas.errors import InputError
 from pointatlas.stores_config import stores_config
 
@@ -22,7 +22,8 @@ from . import lme_kernels as K
 from .lme_kernel_2d import lme_kernel_2d
 from .support import RebuildsCellLists, SupportGrid, locality, nodal_spacing, support_radius, threads_for
 from .validation import (
-    LOCALITY_CONSTRAINTS,
+    NEWTON_CONSTRAINTS,
+    NewtonLocalityConfig,
     check_nodes,
     check_order,
     check_points,
@@ -70,20 +71,14 @@ class LocalMaxEnt(RebuildsCellLists):
     """
 
     @dataclass
-    class Config:
+    class Config(NewtonLocalityConfig):
         gamma: float = 0.8
         tol: float = 1e-10
-        n_spacing_neighbors: Optional[int] = None
-        newton_tol: float = 1e-12
-        max_iter: int = 100
-        outside: str = "error"
         hessians: str = "exact"
         reproduction: str = "linear"
 
         parameter_constraints: ClassVar[dict[str, list]] = {
-            **LOCALITY_CONSTRAINTS,
-            "newton_tol": [Interval(float, 0, None, closed="neither")],
-            "max_iter": [Interval(int, 1, None)],
+            **NEWTON_CONSTRAINTS,
             "hessians": [Options(("exact", "consistent"))],
             "reproduction": [Options(("linear", *POLYNOMIAL_DEGREE))],
         }

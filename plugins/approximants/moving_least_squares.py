@@ -31,19 +31,19 @@ cut-off) wherever M is invertible.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import ClassVar, Optional
+from typing import ClassVar
 
 import numpy as np
 from numba import njit, prange
 
 from pointatlas.basis import BasisFunctions
-from pointatlas.constraints import Interval, Options
+from pointatlas.constraints import Options
 from pointatlas.errors import InputError
 from pointatlas.stores_config import stores_config
 
 from .lme import LocalMaxEnt
 from .support import threads_for
-from .validation import LOCALITY_CONSTRAINTS, check_order, compact_rows
+from .validation import NEWTON_CONSTRAINTS, NewtonLocalityConfig, check_order, compact_rows
 from .weighted_polynomial_fit import _monomials, n_monomials
 
 #: rows whose moment matrix M (offsets scaled by h, weights by their largest) has a
@@ -199,19 +199,13 @@ class MovingLeastSquares(LocalMaxEnt):
     """
 
     @dataclass
-    class Config:
+    class Config(NewtonLocalityConfig):
         gamma: float = 1.8
         tol: float = 1e-10
-        n_spacing_neighbors: Optional[int] = None
-        newton_tol: float = 1e-12
-        max_iter: int = 100
-        outside: str = "error"
         degree: int = 2
 
         parameter_constraints: ClassVar[dict[str, list]] = {
-            **LOCALITY_CONSTRAINTS,
-            "newton_tol": [Interval(float, 0, None, closed="neither")],
-            "max_iter": [Interval(int, 1, None)],
+            **NEWTON_CONSTRAINTS,
             "degree": [Options((2, 3, 4))],
         }
 

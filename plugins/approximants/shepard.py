@@ -13,7 +13,7 @@ Works in any ambient dimension D (markers of a d-manifold in R^D).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import ClassVar, Optional
+from typing import ClassVar
 
 import numba as nb
 import numpy as np
@@ -26,7 +26,7 @@ from pointatlas.stores_config import stores_config
 
 from .support import RebuildsCellLists, SupportGrid, locality, nodal_spacing, scan, support_radius
 from .validation import (
-    LOCALITY_CONSTRAINTS,
+    LocalityConfig,
     check_nodes,
     check_order,
     check_points,
@@ -113,13 +113,9 @@ class Shepard(RebuildsCellLists):
     """
 
     @dataclass
-    class Config:
+    class Config(LocalityConfig):
         gamma: float = 4.0
         tol: float = 1e-6
-        n_spacing_neighbors: Optional[int] = None
-        outside: str = "error"
-
-        parameter_constraints: ClassVar[dict[str, list]] = LOCALITY_CONSTRAINTS
 
     description: ClassVar[str] = "Gaussian Shepard partition of unity (nodal β_a = γ/h_a²)."
 

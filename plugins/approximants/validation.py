@@ -3,6 +3,9 @@
 start-up), the rules that need the nodes, node sets, evaluation points."""
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import ClassVar, Optional
+
 import numpy as np
 
 from pointatlas.constraints import Interval, Options
@@ -19,6 +22,35 @@ LOCALITY_CONSTRAINTS = {
     "n_spacing_neighbors": [Interval(int, 1, None), None],
     "outside": [Options(OUTSIDE_CHOICES)],
 }
+
+#: the dual's Newton solve (LME and the bases on LME's domain)
+NEWTON_CONSTRAINTS = {
+    **LOCALITY_CONSTRAINTS,
+    "newton_tol": [Interval(float, 0, None, closed="neither")],
+    "max_iter": [Interval(int, 1, None)],
+}
+
+
+@dataclass
+class LocalityConfig:
+    """The settings every approximant on nodal Gaussian supports has (β_a = γ/h_a²): a
+    plugin's ``Config`` derives from this and restates ``gamma`` and ``tol`` with its own
+    defaults. Meaning of each: :class:`.lme.LocalMaxEnt`."""
+    gamma: float
+    tol: float
+    n_spacing_neighbors: Optional[int] = None
+    outside: str = "error"
+
+    parameter_constraints: ClassVar[dict[str, list]] = LOCALITY_CONSTRAINTS
+
+
+@dataclass
+class NewtonLocalityConfig(LocalityConfig):
+    """:class:`LocalityConfig` and the settings of LME's Newton solve of the dual."""
+    newton_tol: float = 1e-12
+    max_iter: int = 100
+
+    parameter_constraints: ClassVar[dict[str, list]] = NEWTON_CONSTRAINTS
 
 
 def spacing_neighbors(value, dim: int, n_nodes: int, *, plugin: str) -> int:

@@ -18,17 +18,16 @@ from scipy.spatial import cKDTree
 from pointatlas.errors import InputError
 from pointatlas.executor import current_executor
 
-from . import differential_geometry as dg
-from . import memory_estimate as mem
+from . import differential_geometry as dg, memory_estimate as mem, patch_tasks
 from .settings import GEOMETRY_MARKERS_PER_PATCH, AtlasSettings
 from .chart import Chart, ChartQuadrature
 from .quadrature import simplex_rule
-from .partition import is_connected, partition_markers, refine_partition
+from .partition import (is_connected, label_members, partition_markers, patch_share,
+                        refine_partition, share_at)
 from .chart_coverage import MAX_EDGE_PU, atlas_edge_message, check_chart_edges
 from .chart_fidelity import departed_charts_message, departs
 from .chart_repair import (AtlasError, EmbeddingAttempt, Fresh, embed_control_set,
                            failed_patches_message, repair_embedders)
-from . import patch_tasks
 
 
 @dataclass
@@ -69,8 +68,8 @@ class Atlas:
         key = members.tobytes()
         if key in self._control_sets:
             return self._control_sets[key]
-        psi_all = np.asarray(self.W_points_[:, members].sum(axis=1)).ravel()
-        core = np.flatnonzero(psi_all > self.settings.tol_pu)
+        rows, psi = patch_share(self.W_points_, members)  # O(patch), not O(N)
+        core = rows[psi > self.settings.tol_pu]
         if core.size == 0:
             core = np.unique(self.point_tree_.query(self.markers_[members], k=1)[1])
         indptr, indices = self._margin_neighbors()
@@ -78,8 +77,8 @@ class Atlas:
         counts = stops - starts
         flat = np.repeat(starts - np.cumsum(counts) + counts, counts) + np.arange(counts.sum())
         J = np.unique(np.concatenate([core, indices[flat]]))
-        self._control_sets[key] = (J, psi_all[J])
-        return J, psi_all[J]
+        self._control_sets[key] = (J, share_at(rows, psi, J))
+        return self._control_sets[key]
 
     def _margin_neighbors(self) -> tuple[np.ndarray, np.ndarray]:
         """Points within chart_margin·h of every point, as CSR (indptr, indices); built once."""
@@ -185,16 +184,17 @@ class Atlas:
         self.labels_, self.accepted_, self.patch_depth_ = refine_partition(
             labels, self.adjacency_, self._acceptable, max_depth=s.max_refinement_depth,
             prefetch=self._prefetch_embeddings)
-        attempts = [self._patch_attempt(k) for k in range(self.accepted_.size)]
+        attempts = self._patch_attempts(range(self.accepted_.size))
         self.patch_embedder_ = np.array(["none" if a is None else a.embedder for a in attempts])
         if not self.accepted_.all() and not s.allow_failed_patches:
             raise AtlasError(self._failed_patches_message(refuse=True))
         return self.labels_
 
-    def _patch_attempt(self, k: int) -> Optional[EmbeddingAttempt]:
-        """The embedding kept for final patch k (None: a disconnected patch, never embedded)."""
-        J, _ = self._control_set(np.flatnonzero(self.labels_ == k))
-        return self._embeddings.get(J.tobytes())
+    def _patch_attempts(self, patches) -> list[Optional[EmbeddingAttempt]]:
+        """The embedding kept for each final patch (None: disconnected, never embedded)."""
+        return [self._embeddings.get(self._control_set(members)[0].tobytes())
+                for members in label_members(self.labels_, patches)]
+
 
     def failed_point_fraction(self) -> float:
         """Σ_a Σ_{κ failed} ψ_κ(P_a) / N: the share of the points, by the partition of unity,
@@ -207,7 +207,7 @@ class Atlas:
         s = self.settings
         return failed_patches_message(
             self.markers_, self.labels_, self.accepted_,
-            [self._patch_attempt(k) for k in range(self.accepted_.size)], s.max_stress,
+            self._patch_attempts(range(self.accepted_.size)), s.max_stress,
             s.max_distortion, self.repair_embedders_, self.failed_point_fraction(),
             s.max_refinement_depth, refuse=refuse)
 
@@ -266,7 +266,7 @@ class Atlas:
     def _charts_of(self, patches, progress, desc: str = "charts") -> list[Chart]:
         """The charts of ``patches`` (indices into the labels), each on the embedding the
         chart test accepted (chart_repair); sets their ``support_`` entries."""
-        sets = [self._control_set(np.flatnonzero(self.labels_ == k)) for k in patches]
+        sets = [self._control_set(members) for members in label_members(self.labels_, patches)]
         for k, (_, psi) in zip(patches, sets):
             self.support_[k] = psi
         shared = {"points": self.points_, "make_lme": Fresh(self.make_lme()),
@@ -287,10 +287,9 @@ class Atlas:
                   "order": s.quadrature_order, "tol_pu": s.tol_pu,
                   "need_second": need_second, "keep_basis": keep_basis}
         masks = frame_masks(self)
-        charts = [self.charts_[k] for k in patches]
-        items = [(c, self.support_[k], np.flatnonzero(self.labels_ == k),
-                  None if real is None else np.asarray(real, bool)[c.node_index], masks[k])
-                 for k, c in zip(patches, charts)]
+        charts, members = [self.charts_[k] for k in patches], label_members(self.labels_, patches)
+        items = [(c, self.support_[k], J, None if real is None else np.asarray(real, bool)[
+            c.node_index], masks[k]) for k, c, J in zip(patches, charts, members)]
         return self._map_patches(patch_tasks.quadrature_task, items, shared, desc,
                                  [c.node_index for c in charts], progress)
 

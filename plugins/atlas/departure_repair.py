@@ -112,8 +112,7 @@ def _relabel(atlas, splits: dict[int, list[np.ndarray]], progress) -> dict[int, 
     for lab, chart in zip(new_ids, charts):
         atlas.charts_[lab] = chart
     embedders = list(atlas.patch_embedder_) + [""] * (L - len(atlas.patch_embedder_))
-    for lab in new_ids:
-        attempt = atlas._patch_attempt(lab)
+    for lab, attempt in zip(new_ids, atlas._patch_attempts(new_ids)):
         embedders[lab] = "none" if attempt is None else attempt.embedder
     atlas.patch_embedder_ = np.array(embedders)
     return groups

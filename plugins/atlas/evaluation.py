@@ -12,6 +12,8 @@ import numpy as np
 from pointatlas.basis import BasisFunctions
 from pointatlas.errors import InputError
 
+from .partition import label_groups
+
 
 def node_charts(atlas, nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """For control points ``nodes`` (global ids): the chart with the largest ψ_κ at each,
@@ -48,8 +50,7 @@ def basis_at(atlas, chart: np.ndarray, xi: np.ndarray, order: int = 1) -> BasisF
     chart = np.asarray(chart, dtype=np.int64)
     xi = np.atleast_2d(np.asarray(xi, dtype=np.float64))
     parts, rows = [], []
-    for k in np.unique(chart):
-        sel = np.flatnonzero(chart == k)
+    for k, sel in label_groups(chart):
         c = atlas.charts_[k]
         b = c.approximant.evaluate(xi[sel], order=order)
         if b.outside is not None and b.outside.any():

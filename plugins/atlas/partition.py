@@ -5,11 +5,16 @@ A patch whose chart is not acceptable (disconnected, folded or too distorted whe
 in R^d) is re-partitioned recursively into two (thesis: "we proceed by recursively
 re-partitioning such patches"). The acceptance test is supplied by the caller (the atlas
 builds the chart and measures it); :func:`embedding_defects` gives the measures.
+
+Everything done per patch costs the patch's size, not N (at 10⁶ points and 6 700 patches an
+O(N) step per patch is minutes): the labels are grouped once (:func:`label_groups`), a
+patch's subgraph and its share ψ_κ of the partition of unity are read from its own rows and
+columns (:func:`subgraph`, :func:`patch_share`).
 """
 from __future__ import annotations
 
 import math
-from typing import Callable, Optional
+from typing import Callable, Iterator, Optional
 
 import numpy as np
 from scipy.sparse import coo_matrix, csr_matrix
@@ -17,6 +22,48 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import Delaunay, cKDTree
 
 from pointatlas.errors import ConfigError, InputError
+
+
+def label_groups(labels) -> Iterator[tuple[int, np.ndarray]]:
+    """(k, np.flatnonzero(labels == k)) for every k in np.unique(labels), in that order, from
+    one stable sort: O(n log n) where the loop over k with ``labels == k`` is O(n·K) (at 10⁶
+    points and 6 700 patches, seconds per loop)."""
+    labels = np.asarray(labels)
+    order = np.argsort(labels, kind="stable")
+    ordered = labels[order]
+    starts = np.flatnonzero(np.r_[True, ordered[1:] != ordered[:-1]]) if labels.size else \
+        np.zeros(0, np.int64)
+    ends = np.r_[starts[1:], labels.size]
+    for a, b in zip(starts, ends):
+        yield int(ordered[a]), order[a:b]
+
+
+def label_members(labels, wanted) -> list[np.ndarray]:
+    """[np.flatnonzero(labels == k) for k in wanted], grouping the labels once
+    (:func:`label_groups`)."""
+    groups = dict(label_groups(labels))
+    return [groups.get(int(k), np.zeros(0, np.int64)) for k in wanted]
+
+
+def patch_share(weights, members: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """ψ_κ = Σ_{A ∈ members} w_A at the points: ``weights`` is the (N, M) CSC matrix of the
+    partition of unity's w_A at the points. Returns (rows, ψ_κ there) over the points some
+    member reaches (sorted). Reads only the members' columns, so a patch costs its own
+    size, not N; the sums are those of ``weights[:, members].sum(axis=1)`` bit for bit (the
+    same order of addition)."""
+    sub = weights[:, members]
+    rows, inverse = np.unique(sub.indices, return_inverse=True)
+    return rows, np.bincount(inverse, weights=sub.data, minlength=rows.size)
+
+
+def share_at(rows: np.ndarray, psi: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """ψ_κ at the points ``at`` from :func:`patch_share`'s (rows, ψ_κ): 0 where it is not."""
+    out = np.zeros(len(at))
+    if rows.size:
+        pos = np.minimum(np.searchsorted(rows, at), rows.size - 1)
+        hit = rows[pos] == at
+        out[hit] = psi[pos[hit]]
+    return out
 
 
 def knn_graph(points: np.ndarray, n_neighbors: int) -> csr_matrix:
@@ -66,20 +113,33 @@ def metis_parts(adjacency: csr_matrix, n_parts: int) -> np.ndarray:
     return np.asarray(parts, dtype=np.int64)
 
 
+def subgraph(adjacency: csr_matrix, idx: np.ndarray) -> csr_matrix:
+    """``adjacency[idx][:, idx]`` (distinct idx) with sorted indices, in O(the rows' entries):
+    scipy's column indexing allocates an array of all N columns, O(N) a patch."""
+    rows = adjacency.tocsr()[idx]
+    order = np.argsort(idx, kind="stable")
+    pos = np.minimum(np.searchsorted(idx[order], rows.indices), max(len(idx) - 1, 0))
+    keep = idx[order][pos] == rows.indices if len(idx) else np.zeros(0, bool)
+    row_of = np.repeat(np.arange(len(idx)), np.diff(rows.indptr))[keep]
+    sub = coo_matrix((rows.data[keep], (row_of, order[pos[keep]])),
+                     shape=(len(idx), len(idx))).tocsr()
+    sub.sort_indices()
+    return sub
+
+
 def split_disconnected(adjacency: csr_matrix, labels: np.ndarray) -> np.ndarray:
     """Relabel so that every part induces a connected subgraph (components become parts)."""
     out = np.empty_like(labels)
     next_label = 0
-    for lab in np.unique(labels):
-        idx = np.flatnonzero(labels == lab)
-        n_comp, comp = connected_components(adjacency[idx][:, idx], directed=False)
+    for _, idx in label_groups(labels):
+        n_comp, comp = connected_components(subgraph(adjacency, idx), directed=False)
         out[idx] = next_label + comp
         next_label += n_comp
     return out
 
 
 def is_connected(adjacency: csr_matrix, indices: np.ndarray) -> bool:
-    n_comp, _ = connected_components(adjacency[indices][:, indices], directed=False)
+    n_comp, _ = connected_components(subgraph(adjacency, indices), directed=False)
     return n_comp == 1
 
 
@@ -102,7 +162,7 @@ MIN_PATCH_MARKERS = 8
 
 def bisect_patch(adjacency: csr_matrix, members: np.ndarray) -> list[np.ndarray]:
     """The marker sets of the METIS bisection of patch ``members`` (connected parts)."""
-    sub = adjacency[members][:, members]
+    sub = subgraph(adjacency, members)
     halves = split_disconnected(sub, metis_parts(sub, 2))
     return [members[halves == lab] for lab in np.unique(halves)]
 
@@ -123,7 +183,7 @@ def refine_partition(labels: np.ndarray, adjacency: csr_matrix,
     called with each depth's patches first (the atlas embeds them there in one map on its
     executor, :mod:`pointatlas.executor`). The result does not depend on the order.
     """
-    queue = [(np.flatnonzero(labels == lab), 0) for lab in np.unique(labels)]
+    queue = [(idx, 0) for _, idx in label_groups(labels)]
     final: list[tuple[np.ndarray, bool, int]] = []
     while queue:
         if prefetch is not None:

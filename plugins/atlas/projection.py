@@ -32,6 +32,7 @@ from scipy.spatial import cKDTree
 from pointatlas.errors import InputError
 
 from . import differential_geometry as dg
+from .partition import label_groups
 
 
 @dataclass
@@ -190,8 +191,7 @@ def project_pairs(atlas, x: np.ndarray, rows: np.ndarray, cols: np.ndarray,
     res = ChartNewton(np.full((n, d), np.nan), np.full((n, D), np.nan),
                       np.full((n, d, D), np.nan), np.full(n, np.inf), np.zeros(n, bool),
                       np.zeros(n, np.int64), [])
-    for k in np.unique(cols):
-        sel = np.flatnonzero(cols == k)
+    for k, sel in label_groups(cols):
         ch = atlas.charts_[k]
         _, a = cKDTree(ch.control_points).query(x[rows[sel]], k=1)
         out = newton_on_chart(ch, x[rows[sel]], ch.xi_nodes[a], tol=tol, max_iter=max_iter)

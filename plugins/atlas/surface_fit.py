@@ -38,6 +38,7 @@ from scipy.sparse.linalg import splu
 from pointatlas.errors import InputError
 
 from .chart import chart_derivatives
+from .partition import label_groups
 from .projection import candidate_pairs, project_pairs
 
 
@@ -68,8 +69,7 @@ def sample_pairs(atlas, samples: np.ndarray, sample_nodes: np.ndarray | None = N
     xi = np.full((rows.size, d), np.nan)
     ok = np.zeros(rows.size, bool)
     need = np.ones(rows.size, bool)
-    for k in np.unique(cols):
-        sel = np.flatnonzero(cols == k)
+    for k, sel in label_groups(cols):
         where = np.full(atlas.points_.shape[0], -1, np.int64)
         c = atlas.charts_[k]
         where[c.node_index] = np.arange(c.node_index.size)
@@ -92,8 +92,7 @@ def fit_matrix(atlas, n_samples: int, rows, cols, psi, xi):
     where the chart's LME exists. Returns (M, represented (K,) bool)."""
     N = atlas.points_.shape[0]
     r_all, c_all, v_all, keep_rows, keep_psi = [], [], [], [], []
-    for k in np.unique(cols):
-        sel = np.flatnonzero(cols == k)
+    for k, sel in label_groups(cols):
         ch = atlas.charts_[k]
         b = ch.approximant.evaluate(xi[sel], order=0)
         inside = np.ones(sel.size, bool) if b.outside is None else ~b.outside
@@ -117,8 +116,7 @@ def blended_at_pairs(atlas, n_samples: int, rows, cols, psi, xi) -> np.ndarray:
     D = atlas.points_.shape[1]
     out = np.zeros((n_samples, D))
     total = np.zeros(n_samples)
-    for k in np.unique(cols):
-        sel = np.flatnonzero(cols == k)
+    for k, sel in label_groups(cols):
         X, _, _, outside = atlas.charts_[k].evaluate(xi[sel], order=0)
         good = sel[~outside]
         np.add.at(out, rows[good], psi[good, None] * X[~outside])

@@ -200,14 +200,14 @@ def node_quadrature(atlas, nodes, order: int) -> tuple[AtlasQuadrature, np.ndarr
     undefined (flagged outside, normally none) are left out."""
     from pointatlas_atlas.chart import chart_derivatives
     from pointatlas_atlas.evaluation import node_charts
+    from pointatlas_atlas.partition import label_groups
 
     nodes = np.asarray(nodes, np.int64)
     chart, local = node_charts(atlas, nodes)
     ncol = COLUMNS_FOR_ORDER[order]
     signs = np.asarray(getattr(atlas, "chart_orientation_", np.ones(len(atlas.charts_))), float)
     parts, rows = [], []
-    for k in np.unique(chart):
-        sel = np.flatnonzero(chart == k)
+    for k, sel in label_groups(chart):
         c = atlas.charts_[k]
         b = c.approximant.evaluate(c.xi_nodes[local[sel]], order=max(order, 1))
         if b.outside is not None and b.outside.any():

@@ -43,11 +43,11 @@ def chart_point_quadrature(atlas, chart, xi, weights) -> AtlasQuadrature:
         raise InputError(f"chart_point_quadrature: {len(chart)} charts, {len(xi)} points "
                          f"and {len(weights)} weights; give one of each per point.")
     from pointatlas_atlas.evaluation import stack_rows
+    from pointatlas_atlas.partition import label_groups
 
     X, T = np.zeros((len(chart), 3)), np.zeros((len(chart), 2, 3))
     parts, rows = [], []
-    for k in np.unique(chart):
-        sel = np.flatnonzero(chart == k)
+    for k, sel in label_groups(chart):
         c = atlas.charts_[k]
         b = c.approximant.evaluate(xi[sel], order=1)
         if b.outside is not None and b.outside.any():

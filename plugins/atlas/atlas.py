@@ -195,7 +195,6 @@ class Atlas:
         return [self._embeddings.get(self._control_set(members)[0].tobytes())
                 for members in label_members(self.labels_, patches)]
 
-
     def failed_point_fraction(self) -> float:
         """Σ_a Σ_{κ failed} ψ_κ(P_a) / N: the share of the points, by the partition of unity,
         on patches that fail the chart test (after :meth:`partition`)."""
@@ -288,8 +287,9 @@ class Atlas:
                   "need_second": need_second, "keep_basis": keep_basis}
         masks = frame_masks(self)
         charts, members = [self.charts_[k] for k in patches], label_members(self.labels_, patches)
-        items = [(c, self.support_[k], J, None if real is None else np.asarray(real, bool)[
-            c.node_index], masks[k]) for k, c, J in zip(patches, charts, members)]
+        real = None if real is None else np.asarray(real, bool)
+        items = [(c, self.support_[k], J, None if real is None else real[c.node_index], masks[k])
+                 for k, c, J in zip(patches, charts, members)]
         return self._map_patches(patch_tasks.quadrature_task, items, shared, desc,
                                  [c.node_index for c in charts], progress)
 

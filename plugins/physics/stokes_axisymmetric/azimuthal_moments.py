@@ -35,6 +35,7 @@ of the self-element.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit, prange
 from scipy.special import ellipe, ellipkm1
 
 #: below this elliptic parameter m the trapezoidal rule is used (module doc)
@@ -70,23 +71,43 @@ def _closed_form(a: np.ndarray, b: np.ndarray, amb: np.ndarray) -> np.ndarray:
     return I
 
 
-def _trapezoid(a: np.ndarray, b: np.ndarray, n: int = N_TRAPEZOID,
-               chunk: int = 8192) -> np.ndarray:
-    if len(a) > chunk:
-        return np.concatenate([_trapezoid(a[k:k + chunk], b[k:k + chunk], n)
-                               for k in range(0, len(a), chunk)])
-    phi = (np.arange(n) + 0.5) * (2.0 * np.pi / n)
-    c = np.cos(phi)
-    u = 1.0 - c
-    rho2 = a[..., None] - b[..., None] * c          # (…, n)
-    inv = 1.0 / np.sqrt(rho2)
+@njit(cache=True, parallel=True)
+def _trapezoid_kernel(a, b, c, out):
+    """out[i, k] = (2π/n) Σ_j u_j^{n_k} ρ_ij^{−m_k}, ρ_ij² = a_i − b_i c_j, u_j = 1 − c_j:
+    the periodic trapezoidal rule on the n angles with cosines ``c``, columns as ``PAIRS``
+    ((0,1), (1,1), (0,3), (1,3), (2,3), (0,5), (1,5), (2,5), (3,5))."""
+    n = c.shape[0]
     w = 2.0 * np.pi / n
-    I = np.empty(a.shape + (len(PAIRS),))
-    powers = {1: inv, 3: inv ** 3, 5: inv ** 5}
-    cn = [np.ones_like(u), u, u * u, u * u * u]
-    for k, (nn, mm) in enumerate(PAIRS):
-        I[..., k] = w * (powers[mm] @ cn[nn])
-    return I
+    for i in prange(a.shape[0]):
+        s01 = s11 = s03 = s13 = s23 = s05 = s15 = s25 = s35 = 0.0
+        for j in range(n):
+            u = 1.0 - c[j]
+            inv = 1.0 / np.sqrt(a[i] - b[i] * c[j])
+            i3 = inv * inv * inv
+            i5 = i3 * inv * inv
+            uu = u * u
+            s01 += inv
+            s11 += u * inv
+            s03 += i3
+            s13 += u * i3
+            s23 += uu * i3
+            s05 += i5
+            s15 += u * i5
+            s25 += uu * i5
+            s35 += uu * u * i5
+        out[i, 0], out[i, 1], out[i, 2] = w * s01, w * s11, w * s03
+        out[i, 3], out[i, 4], out[i, 5] = w * s13, w * s23, w * s05
+        out[i, 6], out[i, 7], out[i, 8] = w * s15, w * s25, w * s35
+
+
+def _trapezoid(a: np.ndarray, b: np.ndarray, n: int = N_TRAPEZOID) -> np.ndarray:
+    """The moments of ``PAIRS`` for 1-d a, b by the n-point periodic trapezoidal rule at
+    φ_j = (j + ½) 2π/n (module doc), shape (len(a), 9)."""
+    c = np.cos((np.arange(n) + 0.5) * (2.0 * np.pi / n))
+    out = np.empty((len(a), len(PAIRS)))
+    _trapezoid_kernel(np.ascontiguousarray(a, dtype=np.float64),
+                      np.ascontiguousarray(b, dtype=np.float64), c, out)
+    return out
 
 
 def azimuthal_moments(a, b, amb=None) -> np.ndarray:

@@ -22,20 +22,29 @@ MIN_NODES = 5
 AXIS_TOL = 1e-6
 
 
-def _segments_cross(P: np.ndarray) -> tuple[int, int] | None:
-    """First pair (i, j), j > i + 1, of polyline segments that intersect, or None."""
+def _cross(o, p, q):
+    """z-component of (p − o) × (q − o), broadcast over leading axes."""
+    return ((p[..., 0] - o[..., 0]) * (q[..., 1] - o[..., 1])
+            - (p[..., 1] - o[..., 1]) * (q[..., 0] - o[..., 0]))
+
+
+def _segments_cross(P: np.ndarray, block_entries: int = 1 << 21) -> tuple[int, int] | None:
+    """First pair (i, j), j > i + 1, of polyline segments that intersect properly, or None
+    (lexicographic in (i, j)); all pairs of a block of rows at once, blocks of at most
+    ``block_entries`` pairs."""
     A, B = P[:-1], P[1:]
     n = len(A)
-    for i in range(n - 2):
-        a, b = A[i], B[i]
-        c, d = A[i + 2:], B[i + 2:]
-        cr = lambda o, p, q: ((p[..., 0] - o[..., 0]) * (q[..., 1] - o[..., 1])  # noqa: E731
-                              - (p[..., 1] - o[..., 1]) * (q[..., 0] - o[..., 0]))
-        d1, d2 = cr(c, d, a), cr(c, d, b)
-        d3, d4 = cr(a, b, c), cr(a, b, d)
-        hit = (d1 * d2 < 0) & (d3 * d4 < 0)
+    rows = max(1, block_entries // max(n, 1))
+    j = np.arange(n)
+    for i0 in range(0, max(n - 2, 0), rows):
+        i = np.arange(i0, min(i0 + rows, n - 2))
+        a, b = A[i][:, None], B[i][:, None]
+        c, d = A[None], B[None]
+        hit = ((_cross(c, d, a) * _cross(c, d, b) < 0) & (_cross(a, b, c) * _cross(a, b, d) < 0)
+               & (j[None] >= i[:, None] + 2))
         if hit.any():
-            return i, int(np.argmax(hit)) + i + 2
+            k = int(np.argmax(hit.ravel()))
+            return int(i[k // n]), int(k % n)
     return None
 
 

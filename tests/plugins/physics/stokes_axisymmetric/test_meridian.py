@@ -1,6 +1,8 @@
 """Generating curves: what is refused (one line naming the fix) and the spline's accuracy."""
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from pointatlas.errors import InputError
 from pointatlas_physics.stokes_axisymmetric.meridian import Meridian, check_meridian
@@ -58,3 +60,25 @@ def test_nodal_fields_need_one_value_per_node():
     m = Meridian(circle())
     with pytest.raises(InputError, match="one per node"):
         m.field(np.zeros((10, 3)), (-1, 1, -1))
+
+
+def _first_crossing_by_pairs(P):
+    """Segment pairs one by one, scalar arithmetic: the reference for the block search."""
+    def cross(o, p, q):
+        return (p[0] - o[0]) * (q[1] - o[1]) - (p[1] - o[1]) * (q[0] - o[0])
+    for i in range(len(P) - 3):
+        for j in range(i + 2, len(P) - 1):
+            a, b, c, d = P[i], P[i + 1], P[j], P[j + 1]
+            if cross(c, d, a) * cross(c, d, b) < 0 and cross(a, b, c) * cross(a, b, d) < 0:
+                return i, j
+    return None
+
+
+@settings(max_examples=60, deadline=None)
+@given(n=st.integers(3, 40), seed=st.integers(0, 2**31), wiggle=st.floats(0.0, 0.3),
+       block=st.sampled_from([1, 5, 1 << 21]))
+def test_the_self_crossing_search_finds_the_first_crossing_pair(n, seed, wiggle, block):
+    from pointatlas_physics.stokes_axisymmetric.meridian import _segments_cross
+
+    P = circle(n) + np.random.default_rng(seed).normal(scale=wiggle, size=(n, 2))
+    assert _segments_cross(P, block) == _first_crossing_by_pairs(P)

@@ -35,6 +35,7 @@ the same with d·e_x = Δr + r u (meridional) and d_y² = r² sin²φ (swirl). O
 from __future__ import annotations
 
 import numpy as np
+from numba import njit, prange
 
 from .azimuthal_moments import INDEX, azimuthal_moments
 
@@ -65,32 +66,48 @@ def single_layer(x0, y):
     return out
 
 
-def _poly_mul(p, q):
-    """Product of polynomials in u, coefficients along the last axis (lowest first)."""
-    n = p.shape[-1] + q.shape[-1] - 1
-    out = np.zeros(np.broadcast_shapes(p.shape[:-1], q.shape[:-1]) + (n,))
-    for i in range(p.shape[-1]):
-        for j in range(q.shape[-1]):
-            out[..., i + j] += p[..., i] * q[..., j]
-    return out
+assert all(INDEX[(n, 5)] == 5 + n for n in range(4))  # the layout _moment5 reads
 
 
-def _moment5(L, poly):
-    return sum(poly[..., n] * L[..., INDEX[(n, 5)]] for n in range(poly.shape[-1]))
+@njit(cache=True)
+def _mul21(p0, p1, q0, q1):
+    """(p0 + p1 u)(q0 + q1 u), coefficients lowest first."""
+    return p0 * q0, p0 * q1 + p1 * q0, p1 * q1
 
 
-def _lin(*c):
-    return np.stack(np.broadcast_arrays(*c), axis=-1)
+@njit(cache=True)
+def _mul31(p0, p1, p2, q0, q1):
+    """(p0 + p1 u + p2 u²)(q0 + q1 u), coefficients lowest first."""
+    return p0 * q0, p0 * q1 + p1 * q0, p1 * q1 + p2 * q0, p2 * q1
 
 
-def _factors(x0, y, normal):
-    r0, r, dr, dz, L = _geometry(x0, y)
-    normal = np.asarray(normal, dtype=np.float64)
-    nr, nz = normal[..., 0], normal[..., 1]
-    zero = np.zeros_like(dz)
-    return dict(r0=r0, r=r, L=L, dn=_lin(nr * dr + nz * dz, -nr * r0), d_r=_lin(dr, r),
-                e_r_y=_lin(dr, -r0), d_z=_lin(dz, zero),
-                s2=_lin(zero, 2.0 + zero, -1.0 + zero), c=3.0 * r / (4.0 * np.pi))
+@njit(cache=True)
+def _moment5(L, p):
+    """Σ_n p_n L_{n,5} for a cubic p (columns 5…8 of ``PAIRS`` hold (0,5) … (3,5))."""
+    return p[0] * L[5] + p[1] * L[6] + p[2] * L[7] + p[3] * L[8]
+
+
+@njit(cache=True, parallel=True)
+def _double_layer_kernel(r0, r, dr, dz, nr, nz, L, D, C):
+    """D (m, 5), C (m, 3) of the module doc at m points: the polynomials in u of d·n,
+    d·e_r(x₀), d·e_r(y), d·e_z and sin²φ = 2u − u², multiplied out and integrated against
+    L_{n,5}; × 3r/4π."""
+    for i in prange(r.shape[0]):
+        c = 3.0 * r[i] / (4.0 * np.pi)
+        dn0, dn1 = nr[i] * dr[i] + nz[i] * dz[i], -nr[i] * r0[i]
+        r0_, r_, dr_, dz_ = r0[i], r[i], dr[i], dz[i]
+        rdn = _mul21(dr_, r_, dn0, dn1)               # (d·e_r(x₀)) (d·n)
+        zdn = _mul21(dz_, 0.0, dn0, dn1)              # (d·e_z) (d·n)
+        Li = L[i]
+        D[i, 0] = c * _moment5(Li, _mul31(rdn[0], rdn[1], rdn[2], dr_, -r0_))
+        D[i, 1] = c * _moment5(Li, _mul31(rdn[0], rdn[1], rdn[2], dz_, 0.0))
+        D[i, 2] = c * _moment5(Li, _mul31(zdn[0], zdn[1], zdn[2], dr_, -r0_))
+        D[i, 3] = c * _moment5(Li, _mul31(zdn[0], zdn[1], zdn[2], dz_, 0.0))
+        s2dn = _moment5(Li, _mul31(0.0, 2.0, -1.0, dn0, dn1))
+        D[i, 4] = c * r_ * r0_ * s2dn
+        C[i, 0] = c * _moment5(Li, _mul31(rdn[0], rdn[1], rdn[2], dr_, r_))
+        C[i, 1] = c * _moment5(Li, _mul31(zdn[0], zdn[1], zdn[2], dr_, r_))
+        C[i, 2] = c * r_ ** 2 * s2dn
 
 
 def double_layer(x0, y, normal):
@@ -109,17 +126,12 @@ def double_layer_constant(x0, y, normal):
 
 def double_layer_and_constant(x0, y, normal):
     """(:func:`double_layer`, :func:`double_layer_constant`) from one set of moments."""
-    f = _factors(x0, y, normal)
-    L, c, dn = f["L"], f["c"], f["dn"]
-    D = np.empty(L.shape[:-1] + (5,))
-    d_r, d_z = f["d_r"], f["d_z"]
-    rdn, zdn = _poly_mul(d_r, dn), _poly_mul(d_z, dn)
-    for k, (p, q) in enumerate(((rdn, f["e_r_y"]), (rdn, d_z), (zdn, f["e_r_y"]), (zdn, d_z))):
-        D[..., k] = c * _moment5(L, _poly_mul(p, q))
-    s2dn = _moment5(L, _poly_mul(f["s2"], dn))
-    D[..., 4] = c * f["r"] * f["r0"] * s2dn
-    C = np.empty(L.shape[:-1] + (3,))
-    C[..., 0] = c * _moment5(L, _poly_mul(rdn, d_r))
-    C[..., 1] = c * _moment5(L, _poly_mul(zdn, d_r))
-    C[..., 2] = c * f["r"] ** 2 * s2dn
-    return D, C
+    r0, r, dr, dz, L = _geometry(x0, y)
+    normal = np.asarray(normal, dtype=np.float64)
+    shape = np.broadcast_shapes(dr.shape, dz.shape, normal.shape[:-1])
+    flat = [np.ascontiguousarray(np.broadcast_to(a, shape), dtype=np.float64).ravel()
+            for a in (r0, r, dr, dz, normal[..., 0], normal[..., 1])]
+    L = np.ascontiguousarray(np.broadcast_to(L, shape + L.shape[-1:])).reshape(-1, L.shape[-1])
+    D, C = np.empty((len(flat[0]), 5)), np.empty((len(flat[0]), 3))
+    _double_layer_kernel(*flat, L, D, C)
+    return D.reshape(shape + (5,)), C.reshape(shape + (3,))

@@ -78,6 +78,43 @@ class BasisFunctions:
             gradients=pick(self.gradients), hessians=pick(self.hessians),
             outside=None if self.outside is None else self.outside[rows])
 
+    def compacted(self, rows) -> "BasisFunctions":
+        """:meth:`take` of strictly increasing ``rows`` that reuses this basis's arrays: the
+        kept entries are moved to the front in place, so this basis must not be used
+        afterwards (a chart's basis at its candidate quadrature points, of which it keeps
+        most: no second copy of the values and derivatives is allocated). Scattered rows
+        (more than one run per 8 rows) are taken instead; arrays of which less than half
+        is kept are copied, so the dropped part is freed."""
+        rows = np.asarray(rows, dtype=np.int64)
+        if len(rows) and (np.diff(rows) <= 0).any():
+            raise ValueError("compacted: rows must be strictly increasing")
+        cut = np.flatnonzero(np.diff(rows) != 1) + 1
+        arrays = (self.indices, self.values, self.gradients, self.hessians)
+        if not len(rows) or len(cut) + 1 > max(1, len(rows) // 8) or \
+                not all(a is None or a.flags.writeable for a in arrays):
+            return self.take(rows)
+        first, last = rows[np.r_[0, cut]], rows[np.r_[cut - 1, len(rows) - 1]]
+        spans = list(zip(self.indptr[first], self.indptr[last + 1]))
+        nnz = int(sum(e - s for s, e in spans))
+        keep_views = 2 * nnz >= self.indptr[-1]
+
+        def move(a):
+            if a is None:
+                return None
+            d = 0
+            for s, e in spans:   # d <= s: each run moves towards the front (memmove)
+                if d != s:
+                    a[d:d + e - s] = a[s:e]
+                d += e - s
+            return a[:nnz] if keep_views else a[:nnz].copy()
+
+        counts = np.diff(self.indptr)[rows]
+        return BasisFunctions(
+            indptr=np.concatenate([[0], np.cumsum(counts)]).astype(np.int64),
+            indices=move(self.indices), values=move(self.values),
+            gradients=move(self.gradients), hessians=move(self.hessians),
+            outside=None if self.outside is None else self.outside[rows])
+
     def renumbered(self, node_index) -> "BasisFunctions":
         """The same basis with node indices mapped through ``node_index`` (local -> global)."""
         return BasisFunctions(

@@ -296,7 +296,8 @@ def chart_quadrature(chart: Chart, support_at_nodes: np.ndarray, patch_pu: Calla
     use = psi > tol_pu
     kept = None
     if keep_basis:
-        kept = basis.take(np.flatnonzero(inside)[use]).renumbered(chart.node_index)
+        # the candidates' basis is not used below: its arrays are compacted in place
+        kept = basis.compacted(np.flatnonzero(inside)[use]).renumbered(chart.node_index)
     samples = chart.control_points if chart.samples is None else chart.samples
     departure = chart_departure(xi, samples, simplices[tri[use]], T[use], (wg * J * psi)[use])
     return ChartQuadrature(

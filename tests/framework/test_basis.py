@@ -58,3 +58,49 @@ def test_take_equals_row_by_row_copy_for_runs_and_scattered_rows(sizes, data):
     for name in ("indices", "values", "gradients", "hessians"):
         assert np.array_equal(getattr(s, name), getattr(b, name)[flat]), name
     assert np.array_equal(s.outside, b.outside[rows])
+
+
+@settings(max_examples=80, deadline=None)
+@given(sizes=st.lists(st.integers(0, 5), min_size=1, max_size=60), data=st.data())
+def test_compacted_gives_the_rows_of_take_in_place(sizes, data):
+    """compacted (increasing rows, kept in place) equals take on a fresh copy: runs moved to
+    the front of the same arrays, scattered rows taken; non-increasing rows refused."""
+    import pytest
+
+    m = len(sizes)
+    indptr = np.concatenate([[0], np.cumsum(sizes)])
+    nnz = int(indptr[-1])
+
+    def fresh():
+        return BasisFunctions(indptr.copy(), np.arange(nnz) % 7, np.arange(nnz) * 0.5,
+                              np.arange(2.0 * nnz).reshape(nnz, 2),
+                              np.arange(4.0 * nnz).reshape(nnz, 2, 2), np.arange(m) % 3 == 0)
+
+    keep = np.array(data.draw(st.lists(st.booleans(), min_size=m, max_size=m)))
+    if data.draw(st.booleans()):  # mostly one long run, as a chart's kept points are
+        a = data.draw(st.integers(0, m - 1))
+        keep[:] = False
+        keep[a:data.draw(st.integers(a + 1, m))] = True
+    rows = np.flatnonzero(keep)
+    expected, b = fresh().take(rows), fresh()
+    got = b.compacted(rows)
+    for name in ("indptr", "indices", "values", "gradients", "hessians", "outside"):
+        assert np.array_equal(getattr(got, name), getattr(expected, name)), name
+    if len(rows) > 1:
+        with pytest.raises(ValueError, match="strictly increasing"):
+            fresh().compacted(rows[::-1])
+
+
+def test_compacted_reuses_the_arrays_when_it_keeps_most_of_them():
+    n = 60
+    indptr = np.arange(0, 3 * n + 1, 3)
+    b = BasisFunctions(indptr, np.arange(3 * n), np.arange(3.0 * n),
+                       np.arange(6.0 * n).reshape(-1, 2))
+    values = b.values
+    got = b.compacted(np.r_[2:50, 53:60])
+    assert np.shares_memory(got.values, values) and got.values.tolist() == \
+        list(np.r_[6.0:150.0, 159.0:180.0])
+    source = np.arange(3.0 * n)
+    small = BasisFunctions(indptr, np.arange(3 * n), source).compacted(np.r_[0:20])
+    assert not np.shares_memory(small.values, source)   # a third kept: copied, source freed
+    assert small.values.tolist() == list(np.arange(60.0))

@@ -207,7 +207,12 @@ _blas_controller = None
 
 
 def one_blas_thread():
-    """Context limiting BLAS to one thread (the controller scans the libraries once)."""
+    """Context limiting BLAS to one thread (the controller scans the libraries once).
+
+    The limit is process-wide: enter it in the thread that starts worker threads, not in
+    each worker (a worker's exit restored multithreaded BLAS under the others mid-way and
+    left BLAS at one thread after them; the tangent then differed from call to call at
+    round-off)."""
     global _blas_controller
     from threadpoolctl import ThreadpoolController
 

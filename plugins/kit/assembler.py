@@ -196,7 +196,10 @@ class Assembler:
             for touched, blocks in parts:   # the parts' sums in order, as the threads' are
                 data[touched] += blocks
         else:
-            parts = run_threads(lambda *item: self.tangent_range(*item), items)
+            from pointatlas_atlas.chart import one_blas_thread
+
+            with one_blas_thread():  # the point products are small: BLAS threads only contend
+                parts = run_threads(lambda *item: self.tangent_range(*item), items)
             data = parts[0]
             for extra in parts[1:]:
                 data += extra
@@ -204,26 +207,24 @@ class Assembler:
                           blocksize=(B, B)).tocsr()
 
     def tangent_range(self, U, b0: int, b1: int) -> np.ndarray:
-        """(nnz_blocks, B, B): the tangent blocks of the point blocks b0..b1 of the plan."""
-        from pointatlas_atlas.chart import one_blas_thread
-
+        """(nnz_blocks, B, B): the tangent blocks of the point blocks b0..b1 of the plan.
+        Run it with BLAS at one thread (:meth:`tangent` and :func:`tangent_part` do)."""
         q, L = self.q, self.layout
         plan = q.assembly_plan()
         B = L.block
         data = np.zeros((len(plan.cols), B, B))
         c0 = b0
-        with one_blas_thread():  # the point products are small: BLAS threads only contend
-            while c0 < b1:  # chunks of blocks holding about CHUNK points
-                first = plan.block_ptr[c0]
-                c1 = int(np.searchsorted(plan.block_ptr, first + CHUNK, side="right")) - 1
-                c1 = min(max(c1, c0 + 1), b1)
-                pts = plan.order[first:plan.block_ptr[c1]]
-                _, _, H = self._evaluate(pts, U, 2)
-                tangent_blocks(c0, c1, plan.order, plan.block_ptr, np.int64(first), q.indptr,
-                               q.indices, q.basis, q.weights, H, L.jet_column, L.jet_dof,
-                               *L.field_tables, int(B), int(L.jet_size), plan.row_ptr,
-                               plan.cols, np.int64(L.n_nodes), data)
-                c0 = c1
+        while c0 < b1:  # chunks of blocks holding about CHUNK points
+            first = plan.block_ptr[c0]
+            c1 = int(np.searchsorted(plan.block_ptr, first + CHUNK, side="right")) - 1
+            c1 = min(max(c1, c0 + 1), b1)
+            pts = plan.order[first:plan.block_ptr[c1]]
+            _, _, H = self._evaluate(pts, U, 2)
+            tangent_blocks(c0, c1, plan.order, plan.block_ptr, np.int64(first), q.indptr,
+                           q.indices, q.basis, q.weights, H, L.jet_column, L.jet_dof,
+                           *L.field_tables, int(B), int(L.jet_size), plan.row_ptr,
+                           plan.cols, np.int64(L.n_nodes), data)
+            c0 = c1
         return data
 
 
@@ -255,6 +256,9 @@ def tangent_part(assembler: Assembler, item):
     """One part of :meth:`Assembler.tangent` as a task (item = (U, b0, b1)): (touched,
     blocks), the indices of the pattern blocks it touches and those blocks (what is sent
     back is the part's own rows, not the whole pattern)."""
-    data = assembler.tangent_range(*item)
+    from pointatlas_atlas.chart import one_blas_thread
+
+    with one_blas_thread():  # a task on a worker: its own thread sets and restores
+        data = assembler.tangent_range(*item)
     touched = np.flatnonzero(np.any(data != 0.0, axis=(1, 2)))
     return touched, data[touched]

@@ -195,3 +195,66 @@ def test_a_freed_assemblers_key_is_not_reused_by_the_next(monkeypatch):
     for scale, (on_cluster, local) in residuals.items():
         np.testing.assert_array_equal(on_cluster, local)
     np.testing.assert_allclose(residuals[3.0][0], 3.0 * residuals[1.0][0], rtol=1e-14)
+
+
+class FixedQuadratic:
+    """W = ½ jᵀ A j on the displacement's 15 derivatives, A a fixed random symmetric matrix
+    (one field: the batched BLAS path of the tangent)."""
+
+    fields = (DISP,)
+    density_names = ("quadratic",)
+    frame_invariant = False
+    A = (lambda M: M + M.T)(np.random.default_rng(5).normal(size=(15, 15)))
+
+    def point_data(self, q):
+        return np.zeros((q.n_points, 1))
+
+    def evaluate(self, jets, data, want):
+        Aj = jets @ self.A
+        dens = 0.5 * (jets * Aj).sum(axis=1)[:, None]
+        H = np.broadcast_to(self.A, (len(jets), 15, 15)).copy() if want >= 2 else None
+        return dens, (Aj if want >= 1 else None), H
+
+
+def test_the_tangents_threads_keep_blas_at_one_thread_until_the_last_is_done(monkeypatch):
+    """BLAS is limited to one thread around the tangent's threads, once, by the thread that
+    starts them: a part still running after another has finished has BLAS at one thread,
+    and BLAS has its thread count back afterwards. (With the limit set and restored inside
+    each part, the first part's exit gave the second multithreaded BLAS mid-way, which
+    changed the tangent at round-off from call to call, and left BLAS at one thread.)"""
+    import threading
+
+    import numba
+    from threadpoolctl import threadpool_info, threadpool_limits
+
+    import pointatlas_kit.assembler as asm
+
+    def blas_threads():
+        return sorted({i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"})
+
+    de = DiscreteEnergy((DISP,), [FixedQuadratic()], curved_patch(24))
+    if numba.get_num_threads() < 2 or len(de.assembler.q.assembly_plan().thread_bounds) < 2:
+        pytest.skip("needs two assembly threads")
+    first_done, seen, local = threading.Event(), [], threading.local()
+    tangent_range, tangent_blocks = asm.Assembler.tangent_range, asm.tangent_blocks
+
+    def timed_range(self, U, b0, b1):
+        local.first, local.recorded = b0 == 0, False
+        out = tangent_range(self, U, b0, b1)
+        if b0 == 0:
+            first_done.set()
+        return out
+
+    def watched_blocks(*args):
+        if not local.first and not local.recorded:   # the second part waits for the first
+            first_done.wait(60)
+            seen.append(blas_threads())
+            local.recorded = True
+        return tangent_blocks(*args)
+
+    monkeypatch.setattr(asm.Assembler, "tangent_range", timed_range)
+    monkeypatch.setattr(asm, "tangent_blocks", watched_blocks)
+    with threadpool_limits(limits=2, user_api="blas"):
+        K = de.assembler.tangent(np.zeros(de.n_dofs))
+        assert blas_threads() == [2]
+    assert seen == [[1]] and abs(K).max() > 0

@@ -6,6 +6,16 @@ from dataclasses import dataclass
 import numpy as np
 
 
+def _entry_spans(indptr: np.ndarray, rows: np.ndarray) -> list | None:
+    """The flat-array spans (start, stop) of the runs of consecutive ``rows``, or None when
+    the rows are scattered (more than one run per 8 rows) and are better gathered."""
+    cut = np.flatnonzero(np.diff(rows) != 1) + 1 if len(rows) else np.zeros(0, np.int64)
+    if not len(rows) or len(cut) + 1 > max(1, len(rows) // 8):
+        return None
+    first, last = rows[np.r_[0, cut]], rows[np.r_[cut - 1, len(rows) - 1]]
+    return list(zip(indptr[first], indptr[last + 1]))
+
+
 @dataclass(frozen=True)
 class BasisFunctions:
     """Values and derivatives of n basis functions at m points (sparse, CSR layout).
@@ -58,12 +68,8 @@ class BasisFunctions:
         starts = self.indptr[rows]
         # runs of consecutive rows are contiguous in the flat arrays: copied as slices (memcpy)
         # when there are few of them (a chart's kept quadrature points), else gathered
-        cut = np.flatnonzero(np.diff(rows) != 1) + 1 if len(rows) else np.zeros(0, np.int64)
-        if len(rows) and len(cut) + 1 <= max(1, len(rows) // 8):
-            first = rows[np.r_[0, cut]]
-            last = rows[np.r_[cut - 1, len(rows) - 1]]
-            spans = list(zip(self.indptr[first], self.indptr[last + 1]))
-
+        spans = _entry_spans(self.indptr, rows)
+        if spans is not None:
             def pick(a):
                 return None if a is None else np.concatenate([a[s:e] for s, e in spans])
         else:
@@ -88,13 +94,10 @@ class BasisFunctions:
         rows = np.asarray(rows, dtype=np.int64)
         if len(rows) and (np.diff(rows) <= 0).any():
             raise ValueError("compacted: rows must be strictly increasing")
-        cut = np.flatnonzero(np.diff(rows) != 1) + 1
+        spans = _entry_spans(self.indptr, rows)
         arrays = (self.indices, self.values, self.gradients, self.hessians)
-        if not len(rows) or len(cut) + 1 > max(1, len(rows) // 8) or \
-                not all(a is None or a.flags.writeable for a in arrays):
+        if spans is None or not all(a is None or a.flags.writeable for a in arrays):
             return self.take(rows)
-        first, last = rows[np.r_[0, cut]], rows[np.r_[cut - 1, len(rows) - 1]]
-        spans = list(zip(self.indptr[first], self.indptr[last + 1]))
         nnz = int(sum(e - s for s, e in spans))
         keep_views = 2 * nnz >= self.indptr[-1]
 

@@ -203,22 +203,17 @@ def build_chart(points: np.ndarray, node_index: np.ndarray, embedder, make_appro
 
 #: charts with at most this many control points solve the interpolation system densely
 DENSE_SOLVE_MAX = 2000
-_blas_controller = None
-
-
 def one_blas_thread():
-    """Context limiting BLAS to one thread (the controller scans the libraries once).
+    """Context limiting every BLAS library loaded at entry to one thread.
 
-    The limit is process-wide: enter it in the thread that starts worker threads, not in
-    each worker (a worker's exit restored multithreaded BLAS under the others mid-way and
-    left BLAS at one thread after them; the tangent then differed from call to call at
-    round-off)."""
-    global _blas_controller
+    The libraries are scanned at each entry (1.7 ms): one loaded after a cached scan (MKL,
+    when PARDISO is first used) was left multithreaded. The limit is process-wide: enter it
+    in the thread that starts worker threads, not in each worker (a worker's exit restored
+    multithreaded BLAS under the others mid-way and left BLAS at one thread after them; the
+    tangent then differed from call to call at round-off)."""
     from threadpoolctl import ThreadpoolController
 
-    if _blas_controller is None:
-        _blas_controller = ThreadpoolController()
-    return _blas_controller.limit(limits=1, user_api="blas")
+    return ThreadpoolController().limit(limits=1, user_api="blas")
 
 
 def interpolating_control_points(lme, xi: np.ndarray, samples: np.ndarray,

@@ -229,8 +229,10 @@ def test_the_tangents_threads_keep_blas_at_one_thread_until_the_last_is_done(mon
 
     import pointatlas_kit.assembler as asm
 
-    def blas_threads():
-        return sorted({i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"})
+    def blas_threads():  # the OpenBLAS of numpy and scipy, which the tangent's np.dot calls
+        # (MKL, loaded for PARDISO, keeps its limit per thread and is not used by the tangent)
+        return sorted({i["num_threads"] for i in threadpool_info()
+                       if i["user_api"] == "blas" and i["internal_api"] == "openblas"})
 
     de = DiscreteEnergy((DISP,), [FixedQuadratic()], curved_patch(24))
     if numba.get_num_threads() < 2 or len(de.assembler.q.assembly_plan().thread_bounds) < 2:

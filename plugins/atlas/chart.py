@@ -203,6 +203,8 @@ def build_chart(points: np.ndarray, node_index: np.ndarray, embedder, make_appro
 
 #: charts with at most this many control points solve the interpolation system densely
 DENSE_SOLVE_MAX = 2000
+
+
 def one_blas_thread():
     """Context limiting every BLAS library loaded at entry to one thread.
 

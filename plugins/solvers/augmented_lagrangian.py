@@ -45,7 +45,9 @@ class ConstrainedSystem:
                  reuse: "ConstrainedSystem | None" = None):
         t0 = time.perf_counter()
         self.C, self.tol, self.max_iter = C, tol, max_iter
-        CtC = (C.T @ C).tocsr()
+        # CᵀC of a reused system of the same C (a Newton iteration's) is taken over
+        CtC = reuse._CtC if reuse is not None and reuse.C is C else (C.T @ C).tocsr()
+        self._CtC = CtC
         scale_c = CtC.diagonal().mean() if C.shape[0] else 0.0
         self.rho = penalty * K.diagonal().mean() / scale_c if scale_c > 0 else 0.0
         self.matrix = (K + self.rho * CtC).tocsr()     # K_ρ, for eigen-analysis

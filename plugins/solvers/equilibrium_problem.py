@@ -62,7 +62,10 @@ class EquilibriumProblem(Protocol):
         """Π_ρ(U; μ, λ) given W = W(U) (energy)."""
 
     def system(self, U: np.ndarray, shift: float = 0.0) -> ConstrainedSystem:
-        """The factorised constrained tangent ∂²W/∂U²(U) + shift·I + ρCᵀC; sets :attr:`rho`."""
+        """The factorised constrained tangent ∂²W/∂U²(U) + shift·I + ρCᵀC; sets :attr:`rho`.
+        A call may take over the factorisation of the system the previous call returned
+        (``ConstrainedSystem(..., reuse=)``): the path followers never solve with a system
+        after asking for the next one."""
 
     def lbfgs(self, U: np.ndarray, mu: np.ndarray, lam: float, rel_tol: float,
               max_iter: int, log=None) -> tuple[np.ndarray, int]:

@@ -100,3 +100,28 @@ def test_the_problem_gives_the_path_followers_what_they_ask_for(plate):
     # the arc length measures the sampled points' DOFs, not the ghosts'
     assert eq.arc_mask.sum() == 3 * m.points.shape[0] and eq.arc_mask[:3].all()
     assert eq.length_scale == pytest.approx(float(np.ptp(m.nodes, axis=0).max()))
+
+
+def test_a_new_system_takes_over_the_last_factorisation_and_gives_the_same_answer(plate):
+    """system() hands the previous system's PARDISO handle on (same pattern: no new
+    analysis): the factors are a fresh factorisation's bit for bit, and the old system
+    refuses to solve instead of answering with the new matrix's factors."""
+    from dataclasses import replace
+
+    from pointatlas.errors import PointatlasError
+
+    pytest.importorskip("pypardiso")
+    m, s, F, cons = plate
+    s = replace(s, solver="pardiso")
+    U = 1e-3 * np.random.default_rng(0).standard_normal(3 * m.nodes.shape[0])
+    eq = Equilibrium(m, s, F, cons)
+    first = eq.system(0.5 * U)   # (at U = 0 the flat plate's membrane and bending
+    #                               blocks are exact zeros, dropped: another pattern)
+    second = eq.system(U)
+    fresh = Equilibrium(m, s, F, cons).system(U)
+    assert second.factorization._solver is not None and first.factorization._solver is None
+    b = np.random.default_rng(1).standard_normal(U.size)
+    assert np.array_equal(second.inverse(b), fresh.inverse(b))
+    assert second.negative_pivots == fresh.negative_pivots
+    with pytest.raises(PointatlasError, match="handed on"):
+        first.inverse(b)

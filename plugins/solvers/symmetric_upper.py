@@ -2,8 +2,8 @@
 
 PARDISO's symmetric formats (mtype 2, −2) read the upper triangle in CSR with every diagonal
 entry stored. One pass over the sorted CSR rows gives both that triangle and max |A − Aᵀ|
-(each stored upper a_ij against a_ji, found by bisection in row j; a missing a_ji is 0;
-the lower entries only where one lacks a stored mirror), instead of
+(each stored upper a_ij against a_ji, found by a cursor that walks each row's lower
+entries once; a missing mirror counts as 0), instead of
 forming A − Aᵀ and triu(A) as scipy matrices (1.0 s → about 0.1 s on the 10⁷-entry
 hemisphere shell matrix).
 """
@@ -15,44 +15,42 @@ from scipy.sparse import csr_matrix
 
 
 @njit(cache=True, nogil=True)
-def _position(indptr, indices, i, j):
-    """Position of a_ij in a CSR matrix with sorted column indices, −1 if not stored."""
-    lo, hi = indptr[i], indptr[i + 1]
-    while lo < hi:
-        mid = (lo + hi) // 2
-        if indices[mid] < j:
-            lo = mid + 1
-        else:
-            hi = mid
-    return lo if lo < indptr[i + 1] and indices[lo] == j else -1
-
-
-@njit(cache=True, nogil=True)
 def _asymmetry(indptr, indices, data):
-    """max |a_ij − a_ji| over the stored entries: each upper entry against its mirror; the
-    lower entries are visited only if some has no stored mirror (counted)."""
+    """max |a_ij − a_ji| over the stored entries (a missing mirror is 0), in one pass.
+
+    Rows i are visited in order; each row j keeps a cursor on its lower entries (columns
+    < j, sorted). An upper entry a_ij moves row j's cursor up to column i: a lower entry it
+    passes has no stored mirror (its column's row came earlier and did not stop there),
+    and the one at column i, if any, is a_ji. The lower entries left behind the cursors at
+    the end have no mirror either. Each entry is touched once (the former bisection in
+    row j for every upper entry: 0.084 s against about 0.02 s on the 4.5·10⁶-entry
+    pull-out tangent)."""
     n = len(indptr) - 1
+    cursor = np.empty(n, np.int64)
+    for j in range(n):
+        cursor[j] = indptr[j]
     asym = 0.0
-    matched = 0
-    lower = 0
     for i in range(n):
         for t in range(indptr[i], indptr[i + 1]):
             j = indices[t]
-            if j < i:
-                lower += 1
-            elif j > i:
-                p = _position(indptr, indices, j, i)
-                w = 0.0
-                if p >= 0:
-                    w = data[p]
-                    matched += 1
-                asym = max(asym, abs(data[t] - w))
-    if matched < lower:
-        for i in range(n):
-            for t in range(indptr[i], indptr[i + 1]):
-                j = indices[t]
-                if j < i and _position(indptr, indices, j, i) < 0:
-                    asym = max(asym, abs(data[t]))
+            if j <= i:
+                continue
+            c = cursor[j]
+            end = indptr[j + 1]
+            while c < end and indices[c] < i:   # lower entries of row j without a mirror
+                asym = max(asym, abs(data[c]))
+                c += 1
+            w = 0.0
+            if c < end and indices[c] == i:
+                w = data[c]
+                c += 1
+            cursor[j] = c
+            asym = max(asym, abs(data[t] - w))
+    for j in range(n):   # the lower entries no upper entry reached
+        c = cursor[j]
+        while c < indptr[j + 1] and indices[c] < j:
+            asym = max(asym, abs(data[c]))
+            c += 1
     return asym
 
 

@@ -144,9 +144,13 @@ def _one_field_batches(k0, k1, first, order, indptr, indices, basis, weights, H,
     batches are :func:`.assembly_plan.grow_batch`'s; ``sub``/``snodes`` its scratch arrays).
 
     For a batch S with union node set L_S, K_ab[i, j] = Σ_{q∈S} Σ_kk p_b,kk(q) G[(q, kk),
-    (a, i, j)], G[(q, kk), (a, i, j)] = w_q Σ_k' p_a,k'(q) H_q[k'B + i, kk B + j]: one matrix
+    (a, i, j)], G[(q, kk), (a, i, j)] = w_q Σ_k' p_a,k'(q) H_q[k'B + i, kk B + j]: the matrix
     product Φ_S G (BLAS) of (|L_S|, |S| nc) by (|S| nc, |L_S| B²) per batch; G's rows of a
-    point are themselves one product Φ_q H̃_q. A batch grows while its union stays within
+    point are themselves one product Φ_q H̃_q. With L_S cut in halves (1, 2), Φ_S G is
+    three products (Φ₁G₁, Φ₁G₂, Φ₂G₂): the fourth block is the transpose of Φ₁G₂ (K_ab =
+    K_baᵀ, H symmetric), 3/4 of the multiply-adds (pull-out, 110 nodes and 31 points a
+    batch: 0.56 ms against 0.67 ms per batch on one BLAS thread; the whole tangent 1.24–1.34 s
+    → 1.18–1.20 s, the other half of it being the scatter into G and K_loc). A batch grows while its union stays within
     3/2 of the largest support (so Φ_S is mostly nonzero) and it holds at most 32 points
     (hemisphere, 90 nodes per point: 2.5x faster than one product per point).
     """
@@ -161,11 +165,15 @@ def _one_field_batches(k0, k1, first, order, indptr, indices, basis, weights, H,
         s0 = k
         k, nS = grow_batch(order, k, k1, indptr, indices, cap, sub, snodes)
         mS = k - s0
-        PhiS = np.zeros((nS, nc * mS))
-        G = np.zeros((nc * mS, nS * BB))
+        h = (nS + 1) // 2     # the batch's nodes in two halves: K_ab for b ≥ h, a < h is
+        h2 = nS - h           # K_baᵀ (H symmetric), so three products instead of four
+        Phi1 = np.zeros((h, nc * mS))
+        Phi2 = np.zeros((h2, nc * mS))
+        G1 = np.zeros((nc * mS, h * BB))
+        G2 = np.zeros((nc * mS, h2 * BB))
         for j in range(mS):
             q = order[s0 + j]
-            h = s0 + j - first
+            hq = s0 + j - first
             t0 = indptr[q]
             n = indptr[q + 1] - t0
             w = weights[q]
@@ -177,20 +185,37 @@ def _one_field_batches(k0, k1, first, order, indptr, indices, basis, weights, H,
                 for i in range(B):
                     for kk in range(nc):
                         for jj in range(B):
-                            Hr[kp, kk * BB + i * B + jj] = w * H[h, kp * B + i, kk * B + jj]
+                            Hr[kp, kk * BB + i * B + jj] = w * H[hq, kp * B + i, kk * B + jj]
             T = np.dot(Phi, Hr)  # T[a, (kk, i, j)] = G[(q, kk), (a, i, j)]
             for a in range(n):
                 sa = sub[indices[t0 + a]]
                 for kk in range(nc):
-                    PhiS[sa, j * nc + kk] += Phi[a, kk]
-                    for r in range(BB):
-                        G[j * nc + kk, sa * BB + r] += T[a, kk * BB + r]
-        P = np.dot(PhiS, G)  # P[b, (a, i, j)] = K_ab[i, j]
+                    if sa < h:
+                        Phi1[sa, j * nc + kk] += Phi[a, kk]
+                        for r in range(BB):
+                            G1[j * nc + kk, sa * BB + r] += T[a, kk * BB + r]
+                    else:
+                        Phi2[sa - h, j * nc + kk] += Phi[a, kk]
+                        for r in range(BB):
+                            G2[j * nc + kk, (sa - h) * BB + r] += T[a, kk * BB + r]
+        P11 = np.dot(Phi1, G1)  # P11[b, (a, i, j)] = K_ab[i, j], a, b < h
+        P12 = np.zeros((h, h2 * BB))
+        P22 = np.zeros((h2, h2 * BB))
+        if h2 > 0:
+            P12 = np.dot(Phi1, G2)  # P12[b, (a − h, i, j)] = K_ab[i, j], b < h ≤ a
+            P22 = np.dot(Phi2, G2)  # P22[b − h, (a − h, i, j)] = K_ab[i, j], a, b ≥ h
         for a in range(nS):
             la = gl[snodes[a]]
             for b in range(nS):
                 lb = gl[snodes[b]]
                 for i in range(B):
                     for j in range(B):
-                        Kloc[la, lb, i, j] += P[b, a * BB + i * B + j]
+                        if b < h:
+                            v = P11[b, a * BB + i * B + j] if a < h else \
+                                P12[b, (a - h) * BB + i * B + j]
+                        elif a >= h:
+                            v = P22[b - h, (a - h) * BB + i * B + j]
+                        else:
+                            v = P12[a, (b - h) * BB + j * B + i]   # K_ab = K_baᵀ
+                        Kloc[la, lb, i, j] += v
         sub[snodes[:nS]] = -1

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 from numba import literally, njit
 
-from .assembly_plan import grow_batch
+from .assembly_plan import BATCH_POINTS, grow_batch
 
 
 @njit(cache=True, nogil=True)
@@ -74,6 +74,15 @@ def _tangent_blocks(blk0, blk1, order, block_ptr, first, indptr, indices, basis,
     gl = np.full(n_nodes, -1, np.int64)  # global node -> position in the block's node list
     sub = np.full(n_nodes, -1, np.int64)     # global node -> position in a batch (grow_batch)
     snodes = np.empty(n_nodes, np.int64)
+    # every array of the loops below is a view of buffers allocated here once: a heap
+    # allocation per batch and block was 2x slower where freed memory goes back to the OS
+    # at once (Dask's workers set MALLOC_TRIM_THRESHOLD_=65536: each batch's arrays were
+    # fresh pages, zeroed by the kernel)
+    kbuf = np.empty(0)
+    nmax = 1
+    for k in range(block_ptr[blk0], block_ptr[blk1]):
+        nmax = max(nmax, indptr[order[k] + 1] - indptr[order[k]])
+    scratch = _batch_scratch(nmax if nf == 1 else 0, fncol[0], B)   # (one field only)
     for blk in range(blk0, blk1):
         count = 0
         for k in range(block_ptr[blk], block_ptr[blk + 1]):
@@ -88,12 +97,16 @@ def _tangent_blocks(blk0, blk1, order, block_ptr, first, indptr, indices, basis,
                     gl[A] = nL
                     nodes[nL] = A
                     nL += 1
-        Kloc = np.zeros((nL, nL, B, B))
+        size = nL * nL * B * B
+        if size > kbuf.size:
+            kbuf = np.empty(size)
+        kbuf[:size] = 0.0
+        Kloc = kbuf[:size].reshape((nL, nL, B, B))
         blkv = np.empty((B, B))
         if nf == 1:
             _one_field_batches(block_ptr[blk], block_ptr[blk + 1], first, order, indptr,
                                indices, basis, weights, H, fcol[0], fncol[0], B, gl, sub,
-                               snodes, Kloc)
+                               snodes, Kloc, scratch)
         else:
             for k in range(block_ptr[blk], block_ptr[blk + 1]):
                 q = order[k]
@@ -137,8 +150,27 @@ def _tangent_blocks(blk0, blk1, order, block_ptr, first, indptr, indices, basis,
 
 
 @njit(cache=True, nogil=True)
+def _batch_scratch(nmax, nc, B):
+    """Flat buffers for :func:`_one_field_batches` of points with at most ``nmax`` nodes:
+    (Φ₁, Φ₂, G₁, G₂, P₁₁, P₁₂, P₂₂, Φ_q, T_q, H̃), each large enough for any batch."""
+    h = ((3 * nmax) // 2 + 1) // 2      # half of the largest batch's node set
+    BB = B * B
+    m = nc * BATCH_POINTS
+    return (np.empty(h * m), np.empty(h * m), np.empty(m * h * BB), np.empty(m * h * BB),
+            np.empty(h * h * BB), np.empty(h * h * BB), np.empty(h * h * BB),
+            np.empty(nmax * nc), np.empty(nmax * nc * BB), np.empty(nc * nc * BB))
+
+
+@njit(cache=True, nogil=True)
+def _zeroed(buf, rows, cols):
+    """buf's first rows·cols entries, set to 0, as a (rows, cols) array."""
+    buf[:rows * cols] = 0.0
+    return buf[:rows * cols].reshape((rows, cols))
+
+
+@njit(cache=True, nogil=True)
 def _one_field_batches(k0, k1, first, order, indptr, indices, basis, weights, H, c0, nc, B,
-                       gl, sub, snodes, Kloc):
+                       gl, sub, snodes, Kloc, scratch):
     """Kloc += the tangent of the points order[k0:k1] of a single-field layout, in batches of
     consecutive points whose supports overlap (the plan orders points by nearest node; the
     batches are :func:`.assembly_plan.grow_batch`'s; ``sub``/``snodes`` its scratch arrays).
@@ -150,16 +182,19 @@ def _one_field_batches(k0, k1, first, order, indptr, indices, basis, weights, H,
     three products (Φ₁G₁, Φ₁G₂, Φ₂G₂): the fourth block is the transpose of Φ₁G₂ (K_ab =
     K_baᵀ, H symmetric), 3/4 of the multiply-adds (pull-out, 110 nodes and 31 points a
     batch: 0.56 ms against 0.67 ms per batch on one BLAS thread; the whole tangent 1.24–1.34 s
-    → 1.18–1.20 s, the other half of it being the scatter into G and K_loc). A batch grows while its union stays within
-    3/2 of the largest support (so Φ_S is mostly nonzero) and it holds at most 32 points
-    (hemisphere, 90 nodes per point: 2.5x faster than one product per point).
+    → 1.18–1.20 s, the other half of it being the scatter into G and K_loc). A batch grows
+    while its union stays within 3/2 of the largest support (so Φ_S is mostly nonzero) and
+    it holds at most 32 points (hemisphere, 90 nodes per point: 2.5x faster than one product
+    per point). Every array is a view of ``scratch`` (:func:`_batch_scratch`), so a batch
+    allocates nothing.
     """
     nmax = 1
     for k in range(k0, k1):
         nmax = max(nmax, indptr[order[k] + 1] - indptr[order[k]])
     cap = (3 * nmax) // 2
     BB = B * B
-    Hr = np.empty((nc, nc * BB))
+    sPhi1, sPhi2, sG1, sG2, sP11, sP12, sP22, sPhi, sT, sHr = scratch
+    Hr = sHr[:nc * nc * BB].reshape((nc, nc * BB))
     k = k0
     while k < k1:
         s0 = k
@@ -167,17 +202,17 @@ def _one_field_batches(k0, k1, first, order, indptr, indices, basis, weights, H,
         mS = k - s0
         h = (nS + 1) // 2     # the batch's nodes in two halves: K_ab for b ≥ h, a < h is
         h2 = nS - h           # K_baᵀ (H symmetric), so three products instead of four
-        Phi1 = np.zeros((h, nc * mS))
-        Phi2 = np.zeros((h2, nc * mS))
-        G1 = np.zeros((nc * mS, h * BB))
-        G2 = np.zeros((nc * mS, h2 * BB))
+        Phi1 = _zeroed(sPhi1, h, nc * mS)
+        Phi2 = _zeroed(sPhi2, h2, nc * mS)
+        G1 = _zeroed(sG1, nc * mS, h * BB)
+        G2 = _zeroed(sG2, nc * mS, h2 * BB)
         for j in range(mS):
             q = order[s0 + j]
             hq = s0 + j - first
             t0 = indptr[q]
             n = indptr[q + 1] - t0
             w = weights[q]
-            Phi = np.empty((n, nc))
+            Phi = sPhi[:n * nc].reshape((n, nc))
             for a in range(n):
                 for kk in range(nc):
                     Phi[a, kk] = basis[t0 + a, c0 + kk]
@@ -186,7 +221,8 @@ def _one_field_batches(k0, k1, first, order, indptr, indices, basis, weights, H,
                     for kk in range(nc):
                         for jj in range(B):
                             Hr[kp, kk * BB + i * B + jj] = w * H[hq, kp * B + i, kk * B + jj]
-            T = np.dot(Phi, Hr)  # T[a, (kk, i, j)] = G[(q, kk), (a, i, j)]
+            T = sT[:n * nc * BB].reshape((n, nc * BB))
+            np.dot(Phi, Hr, T)  # T[a, (kk, i, j)] = G[(q, kk), (a, i, j)]
             for a in range(n):
                 sa = sub[indices[t0 + a]]
                 for kk in range(nc):
@@ -198,12 +234,13 @@ def _one_field_batches(k0, k1, first, order, indptr, indices, basis, weights, H,
                         Phi2[sa - h, j * nc + kk] += Phi[a, kk]
                         for r in range(BB):
                             G2[j * nc + kk, (sa - h) * BB + r] += T[a, kk * BB + r]
-        P11 = np.dot(Phi1, G1)  # P11[b, (a, i, j)] = K_ab[i, j], a, b < h
-        P12 = np.zeros((h, h2 * BB))
-        P22 = np.zeros((h2, h2 * BB))
+        P11 = sP11[:h * h * BB].reshape((h, h * BB))
+        P12 = sP12[:h * h2 * BB].reshape((h, h2 * BB))
+        P22 = sP22[:h2 * h2 * BB].reshape((h2, h2 * BB))
+        np.dot(Phi1, G1, P11)  # P11[b, (a, i, j)] = K_ab[i, j], a, b < h
         if h2 > 0:
-            P12 = np.dot(Phi1, G2)  # P12[b, (a − h, i, j)] = K_ab[i, j], b < h ≤ a
-            P22 = np.dot(Phi2, G2)  # P22[b − h, (a − h, i, j)] = K_ab[i, j], a, b ≥ h
+            np.dot(Phi1, G2, P12)  # P12[b, (a − h, i, j)] = K_ab[i, j], b < h ≤ a
+            np.dot(Phi2, G2, P22)  # P22[b − h, (a − h, i, j)] = K_ab[i, j], a, b ≥ h
         for a in range(nS):
             la = gl[snodes[a]]
             for b in range(nS):

@@ -23,7 +23,7 @@ def _asymmetry(indptr, indices, data):
     passes has no stored mirror (its column's row came earlier and did not stop there),
     and the one at column i, if any, is a_ji. The lower entries left behind the cursors at
     the end have no mirror either. Each entry is touched once (the former bisection in
-    row j for every upper entry: 0.084 s against about 0.02 s on the 4.5·10⁶-entry
+    row j for every upper entry: 0.084 s against 0.039 s on the 4.5·10⁶-entry
     pull-out tangent)."""
     n = len(indptr) - 1
     cursor = np.empty(n, np.int64)

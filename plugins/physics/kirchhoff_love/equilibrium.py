@@ -33,6 +33,7 @@ class Equilibrium:
         self.F = np.asarray(F, dtype=float).ravel()
         self.constraints = constraints
         self.rho = None   # set by the first factorisation (scale free, from diag K)
+        self._last_system = None   # handed on to the next system() (reuse)
         # what the path followers ask of the problem (pointatlas_solvers.equilibrium_problem)
         n_nodes, n_real = model.nodes.shape[0], model.points.shape[0]
         self.n_components, self.row_support = 3, constraints.row_support
@@ -91,7 +92,7 @@ class Equilibrium:
              + diags(self.springs + shift)).tocsr()
         sys = ConstrainedSystem(K, self.C, self.settings.penalty, self.settings.constraint_tol,
                                 backend=self.settings.solver,
-                                reuse=getattr(self, "_last_system", None))
+                                reuse=self._last_system)
         self._last_system = sys
         self.rho = sys.rho
         return sys

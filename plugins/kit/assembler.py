@@ -185,9 +185,17 @@ class Assembler:
 
     def tangent(self, U):
         """K = ∂²Π/∂U² as scipy CSR (n_dofs, n_dofs), symmetric."""
-        U = self.layout.as_blocks(U)
         plan = self.q.assembly_plan()
         B, N = self.layout.block, self.layout.n_nodes
+        return bsr_matrix((self.tangent_data(U), plan.cols, plan.row_ptr),
+                          shape=(B * N, B * N), blocksize=(B, B)).tocsr()
+
+    def tangent_data(self, U) -> np.ndarray:
+        """(nnz_blocks, B, B): K's node blocks on the pattern of :meth:`AtlasQuadrature.
+        assembly_plan` (its ``row_ptr``, ``cols``)."""
+        U = self.layout.as_blocks(U)
+        plan = self.q.assembly_plan()
+        B = self.layout.block
         bounds = split_for_cluster([(int(b0), int(b1)) for b0, b1 in plan.thread_bounds])
         items = [(U, b0, b1) for b0, b1 in bounds]
         if current_executor().distributed:
@@ -203,8 +211,7 @@ class Assembler:
             data = parts[0]
             for extra in parts[1:]:
                 data += extra
-        return bsr_matrix((data, plan.cols, plan.row_ptr), shape=(B * N, B * N),
-                          blocksize=(B, B)).tocsr()
+        return data
 
     def tangent_range(self, U, b0: int, b1: int) -> np.ndarray:
         """(nnz_blocks, B, B): the tangent blocks of the point blocks b0..b1 of the plan.

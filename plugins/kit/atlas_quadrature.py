@@ -157,8 +157,18 @@ def atlas_quadrature(atlas, order: int, release_basis: bool = False) -> AtlasQua
         raise InputError("the atlas quadrature has no basis: build it with "
                          "atlas.build_quadrature(keep_basis=True) (a physics model releases "
                          "the atlas's copy: use its quadrature).")
-    ncol = COLUMNS_FOR_ORDER[order]
     parts = [(k, c) for k, c in enumerate(q) if len(c.weights)]
+    signs = np.asarray(getattr(atlas, "chart_orientation_", np.ones(len(q))), float)
+    return pack_quadrature(parts, signs, atlas.points_.shape[0], order, release_basis)
+
+
+def pack_quadrature(parts, signs, n_nodes: int, order: int,
+                    release_basis: bool = False) -> AtlasQuadrature:
+    """The :class:`AtlasQuadrature` of the charts ``parts`` = [(chart id k, its
+    ChartQuadrature with ``basis`` in global node ids)], ``signs`` (L,) the charts'
+    orientations, basis columns up to chart derivative ``order``; ``release_basis`` drops
+    each chart's basis once copied (see :func:`atlas_quadrature`)."""
+    ncol = COLUMNS_FOR_ORDER[order]
     if order >= 2 and any(c.second is None or c.basis.hessians is None for _, c in parts):
         raise InputError("order-2 fields need the charts' second derivatives: build the "
                          "quadrature with need_second=True.")
@@ -185,11 +195,10 @@ def atlas_quadrature(atlas, order: int, release_basis: bool = False) -> AtlasQua
         if release_basis:
             c.basis = None
         p0, z0 = p1, z1
-    signs = np.asarray(getattr(atlas, "chart_orientation_", np.ones(len(q))), float)
     return AtlasQuadrature(
         indptr=indptr, indices=indices, basis=basis, weights=weights, chart=chart,
-        positions=positions, tangents=tangents, second=second, orientation=signs[chart],
-        n_nodes=atlas.points_.shape[0])
+        positions=positions, tangents=tangents, second=second,
+        orientation=np.asarray(signs, float)[chart], n_nodes=n_nodes)
 
 
 def node_quadrature(atlas, nodes, order: int) -> tuple[AtlasQuadrature, np.ndarray]:

@@ -121,12 +121,15 @@ def check_surface_cloud(cloud, n_neighbors: int, allow_creases: bool = False) ->
 
 def build_surface_model(cloud, atlas_settings, make_embedder, make_lme, make_pu, *,
                         order: int, ghost_layers: int = 2, block: int = 1,
-                        log=None) -> SurfaceModel:
+                        log=None, keep_basis: bool = True) -> SurfaceModel:
     """Boundary, ghosts, atlas and quadrature (basis to chart derivative ``order``).
 
     Refuses before any work a model that cannot fit in memory: the atlas with its basis
     plus the tangent of ``block`` DOFs per node and its solve
-    (:func:`pointatlas_atlas.memory_estimate.estimate_tangent_bytes`)."""
+    (:func:`pointatlas_atlas.memory_estimate.estimate_tangent_bytes`). Without
+    ``keep_basis`` the atlas keeps only its charts and Gauss points (``quadrature`` is None)
+    and the estimate counts the tangent's parts and sum, not its solve: the model of
+    :func:`.streamed_tangent.streamed_tangent`, which rebuilds the basis group by group."""
     import time
 
     from pointatlas_atlas.atlas import Atlas
@@ -160,8 +163,9 @@ def build_surface_model(cloud, atlas_settings, make_embedder, make_lme, make_pu,
 
     s = atlas_settings
     tangent = estimate_tangent_bytes(nodes.shape[0], block,
-                                     support_size(2, s.gamma_lme, s.tol_lme))
-    atlas.partition(nodes, markers, keep_basis=True, extra_bytes=tangent,  # AtlasError:
+                                     support_size(2, s.gamma_lme, s.tol_lme),
+                                     **({} if keep_basis else {"copies": 2}))
+    atlas.partition(nodes, markers, keep_basis=keep_basis, extra_bytes=tangent,  # AtlasError:
                     extra_what=f"a tangent of {block} DOF per node")     # charts fail
     warning = atlas.refinement_warning()  # only with atlas.allow_failed_patches=true
     if warning and log is not None:
@@ -169,32 +173,39 @@ def build_surface_model(cloud, atlas_settings, make_embedder, make_lme, make_pu,
     c2, t2 = compile_seconds(), time.perf_counter()
     atlas.build_charts()
     c3, t3 = compile_seconds(), time.perf_counter()
-    atlas.build_quadrature(real=real, keep_basis=True, need_second=order >= 2)
+    atlas.build_quadrature(real=real, keep_basis=keep_basis, need_second=order >= 2)
     check_dropped_quadrature(atlas)
-    quadrature = atlas_quadrature(atlas, order, release_basis=True)
+    quadrature = atlas_quadrature(atlas, order, release_basis=True) if keep_basis else None
     c4, t4 = compile_seconds(), time.perf_counter()
     # stage times without numba's compilation (pointatlas.jit_time), which a process's first
     # model pays wherever it first calls a kernel
     times.update(boundary=(t1 - t0) - (c1 - c0), partition=(t2 - t1) - (c2 - c1),
                  charts=(t3 - t2) - (c3 - c2), quadrature=(t4 - t3) - (c4 - c3))
-    touched = np.zeros(nodes.shape[0], bool)
-    touched[quadrature.indices] = True
-    lonely = np.flatnonzero(real & ~touched)
-    if lonely.size:
-        raise InputError(
-            f"{lonely.size} point(s) (first: {lonely[:5].tolist()}) lie in no chart's "
-            "quadrature: the point cloud is too sparse or irregular there for the chart "
-            "support. Sample the surface more densely or lower atlas.markers_per_patch.")
+    if quadrature is not None:
+        touched = np.zeros(nodes.shape[0], bool)
+        touched[quadrature.indices] = True
+        check_every_point_integrated(touched, real)
     if log is not None:
         log.info("%d points (%d on the boundary, %d curves) + %d ghosts; %d patches, "
                  "%d quadrature points", P.shape[0], int(boundary.sum()), len(curves),
-                 G.shape[0], len(atlas.charts_), quadrature.n_points)
+                 G.shape[0], len(atlas.charts_), sum(len(c.weights) for c in atlas.quadrature_))
     return SurfaceModel(P, nodes, boundary, curves, spacing, atlas, quadrature, times)
 
 
 #: the largest partition-of-unity weight ψ_κ a dropped Gauss point may carry (a point where
 #: the chart's basis does not exist: outside the hull of its nodes, or refused by the basis)
 LOST_PU_LIMIT = 1.0e-3
+
+
+def check_every_point_integrated(touched: np.ndarray, real: np.ndarray) -> None:
+    """Refuse a model where a sample (``real`` node) carries no basis function at any Gauss
+    point (``touched`` False): its DOFs would be free."""
+    lonely = np.flatnonzero(real & ~touched)
+    if lonely.size:
+        raise InputError(
+            f"{lonely.size} point(s) (first: {lonely[:5].tolist()}) lie in no chart's "
+            "quadrature: the point cloud is too sparse or irregular there for the chart "
+            "support. Sample the surface more densely or lower atlas.markers_per_patch.")
 
 
 def check_dropped_quadrature(atlas) -> None:

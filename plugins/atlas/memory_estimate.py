@@ -107,7 +107,7 @@ TANGENT_COPIES = 4
 
 
 def estimate_tangent_bytes(n_nodes: int, block: int, support_size: float,
-                           copies: int = TANGENT_COPIES) -> int:
+                           copies: float = TANGENT_COPIES) -> int:
     """Bytes of a physics' sparse tangent and its solve on ``n_nodes`` atlas nodes with
     ``block`` DOFs each: two nodes couple when their supports (radius r, ``support_size``
     s = π r² nodes on a surface) overlap, so about 4 s neighbours a node; each coupling is a

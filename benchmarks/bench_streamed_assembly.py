@@ -5,7 +5,9 @@ At 2·10⁵ points the kit's quadrature with its basis would need ~70 GiB
 ``build_surface_model(keep_basis=False)`` (charts and Gauss points only) and K of the linear
 Kirchhoff–Love energy at U = 0 is assembled by :func:`pointatlas_kit.streamed_tangent.
 streamed_tangent`: chart groups rebuild their basis, assemble and drop it; the client sums the
-parts. The cloud is the quarter hemisphere of ``experiment=shell_hemisphere`` (radius 10,
+parts; K is kept as its block upper triangle (``upper=True``: K is symmetric, and the parts
+and K then need half the memory; the full K of 2·10⁵ points is 8 GB in CSR). The cloud is
+the quarter hemisphere of ``experiment=shell_hemisphere`` (radius 10,
 closed pole, E = 6.825e7, ν = 0.3, h = 0.04), with its atlas settings (embedder pca).
 
 Each configuration runs in a fresh child process (``local``: this process with numba's
@@ -16,7 +18,7 @@ partition: serial on the client; charts, quadrature: patch tasks; tangent: group
 client's sum of the parts: serial), the tasks' compute time (Dask task stream) and the
 per-task overhead (wall × threads − Σ compute) / tasks, the serial fraction (partition +
 sum) / total, peak RSS of the client and each worker (psutil, every 0.1 s), K's size and a
-fingerprint (‖K v‖ for a fixed v, compared between configurations).
+fingerprint (‖U v‖ of the stored triangle U for a fixed v, compared between configurations).
 
 Usage:
   python benchmarks/bench_streamed_assembly.py --n 200000 --configs local dask1 dask2
@@ -79,7 +81,7 @@ def build_and_assemble(n: int, group_points: int) -> dict:
     layout = FieldLayout([DISPLACEMENT], m.nodes.shape[0])
     t0 = time.perf_counter()
     K = st.streamed_tangent(m.atlas, layout, [ShellEnergy(6.825e7, 0.3, 0.04)],
-                           group_points=group_points)
+                            group_points=group_points, upper=True)
     times["tangent_wall"] = time.perf_counter() - t0
     times["sum_wall"] = summed["s"]
     touched = np.zeros(layout.n_nodes, bool)

@@ -47,8 +47,11 @@ class Executor(Protocol):
 
     def map(self, fn: Callable[[Any, Any], Any], items: Sequence, *, shared: Any = None,
             shared_key: Any = None, desc: str = "tasks",
-            labels: Sequence[str] | None = None, costs: Sequence[float] | None = None
-            ) -> list: ...
+            labels: Sequence[str] | None = None, costs: Sequence[float] | None = None,
+            min_tasks: int | None = None) -> list:
+        """``[fn(shared, item) for item in items]``; a distributed executor sends the items
+        in contiguous batches of about equal ``costs``, about max(its default, ``min_tasks``)
+        of them (items that are each a task's worth of work and data: ``len(items)``)."""
 
     def close(self) -> None: ...
 
@@ -59,7 +62,7 @@ class SerialExecutor:
     distributed = False
 
     def map(self, fn, items, *, shared=None, shared_key=None, desc="tasks", labels=None,
-            costs=None) -> list:
+            costs=None, min_tasks=None) -> list:
         out = []
         for i, item in enumerate(items):
             try:

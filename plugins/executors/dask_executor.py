@@ -204,7 +204,7 @@ class DaskExecutor:
         return future
 
     def map(self, fn, items, *, shared=None, shared_key=None, desc="tasks", labels=None,
-            costs=None) -> list:
+            costs=None, min_tasks=None) -> list:
         """``[fn(shared, item) for item in items]`` as batched tasks on the cluster.
 
         Scattered data lives on workers: Dask re-runs the tasks of a lost worker, but not
@@ -223,7 +223,8 @@ class DaskExecutor:
         labels = list(labels) if labels is not None else [f"item {i}" for i in range(len(items))]
         threads = self.n_threads()
         costs = np.ones(len(items)) if costs is None else np.asarray(costs, dtype=np.float64)
-        batches = balanced_ranges(costs, min(len(items), self.tasks_per_thread * threads))
+        n_tasks = max(self.tasks_per_thread * threads, int(min_tasks or 0))
+        batches = balanced_ranges(costs, min(len(items), n_tasks))
         token = next(_TOKENS)
         results: list = [None] * len(batches)
         pending = list(range(len(batches)))
@@ -275,7 +276,8 @@ class DaskExecutor:
                     raise TaskError(f"{desc}: a task failed on the cluster: "
                                     f"{type(exc).__name__}: {exc}") from None
                 results[index[future.key]] = future.result()
-                bar.update(1)
+                client.cancel([future])   # the worker frees its copy of the result now,
+                bar.update(1)             # not when the whole map is done
         finally:
             client.cancel([f for f in futures if not f.done()])
             if shared_key is None:

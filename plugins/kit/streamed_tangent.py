@@ -80,7 +80,8 @@ def with_basis(chart, quadrature, order: int):
 
 def tangent_of_charts(shared: dict, item: tuple):
     """A task: the tangent part of charts ``item`` = (ids, charts, Gauss points) as
-    (rows, row lengths, cols, blocks (nnz, B, B)) of the node-block rows it touches."""
+    (rows, row lengths, cols, blocks (nnz, B, B)) of the node-block rows it touches (with
+    ``shared['upper']`` the blocks of cols ≥ row only)."""
     from .assembler import Assembler
     from .atlas_quadrature import pack_quadrature
 
@@ -93,13 +94,19 @@ def tangent_of_charts(shared: dict, item: tuple):
     blocks = asm.tangent_data(shared["U"])   # this process's threads (one on a worker)
     plan = q.assembly_plan()
     lengths = np.diff(plan.row_ptr)
+    cols = plan.cols
+    if shared["upper"]:
+        keep = cols >= np.repeat(np.arange(len(lengths)), lengths)
+        cols, blocks = cols[keep], blocks[keep]
+        lengths = np.bincount(np.repeat(np.arange(len(lengths)), lengths)[keep],
+                              minlength=len(lengths))
     rows = np.flatnonzero(lengths)
     del asm, q
     # a tangent call leaves ~6 500 objects in reference cycles, some holding the group's
     # arrays (measured: 0.05–0.5 GiB per 40 000 Gauss points, a local run at 2·10⁴ points
     # reached 7.5 GiB): collected here so that a process holds one group at a time
     gc.collect()
-    return rows, lengths[rows], plan.cols, blocks
+    return rows, lengths[rows], cols, blocks
 
 
 @njit(cache=True)
@@ -162,11 +169,13 @@ def sum_block_parts(parts: list, n_nodes: int, block: int):
 
 
 def streamed_tangent(atlas, layout, energies, U=None, order: int = 2,
-                     group_points: int = GROUP_POINTS):
+                     group_points: int = GROUP_POINTS, upper: bool = False):
     """K = ∂²Π/∂U² of ``energies`` over ``layout`` on an atlas built with
     ``build_quadrature(keep_basis=False)``, as a scipy BSR matrix of B × B node blocks
     (``.tocsr()`` for the solvers), group by group on the run's executor (module docstring).
-    ``U`` (n_nodes, B) or (n_dofs,) defaults to zero (the linear problem's K)."""
+    ``U`` (n_nodes, B) or (n_dofs,) defaults to zero (the linear problem's K). ``upper``:
+    only the node blocks K_ab with b ≥ a (K is symmetric: K = U + Uᵀ − blockdiag U), half
+    the memory of the parts and of K."""
     quads = getattr(atlas, "quadrature_", None)
     if not quads:
         raise InputError("the atlas has no quadrature: call atlas.build_quadrature(...) "
@@ -175,14 +184,15 @@ def streamed_tangent(atlas, layout, energies, U=None, order: int = 2,
     signs = np.asarray(getattr(atlas, "chart_orientation_", np.ones(len(quads))), float)
     groups = chart_groups(quads, group_points)
     items = [(g, [atlas.charts_[k] for k in g], [quads[k] for k in g]) for g in groups]
-    shared = dict(order=order, signs=signs, layout=layout, energies=list(energies), U=U)
+    shared = dict(order=order, signs=signs, layout=layout, energies=list(energies), U=U,
+                  upper=bool(upper))
     P = atlas.points_
     labels = [f"charts {', '.join(map(str, g[:3]))}{', …' if len(g) > 3 else ''} "
               f"({sum(len(quads[k].weights) for k in g)} Gauss points near "
               f"({', '.join(f'{v:.3g}' for v in P[atlas.charts_[g[0]].node_index].mean(0))}))"
               for g in groups]
     parts = current_executor().map(tangent_of_charts, items, shared=shared,
-                                   desc="streamed tangent", labels=labels,
+                                   desc="streamed tangent", labels=labels, min_tasks=len(items),
                                    costs=[sum(len(quads[k].weights) for k in g) for g in groups])
     del items
     return sum_block_parts(parts, layout.n_nodes, layout.block)

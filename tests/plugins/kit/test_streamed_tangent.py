@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from scipy.sparse import bsr_matrix
 
 import pointatlas
 from pointatlas.errors import InputError
@@ -64,6 +65,16 @@ def test_the_streamed_tangent_is_the_kits_tangent(model, deformed):
     # one group is the whole atlas: the same sums in another order
     whole = streamed_tangent(m.atlas, layout, energies, U, group_points=10**9)
     assert relative_difference(whole.tocsr(), expected) <= 1e-12
+    # the block upper triangle: K = U + Uᵀ − blockdiag U
+    up = streamed_tangent(m.atlas, layout, energies, U, group_points=3000, upper=True)
+    assert len(up.indices) < 0.6 * len(got.indices)
+    rows = np.repeat(np.arange(layout.n_nodes), np.diff(up.indptr))
+    assert (up.indices >= rows).all()
+    on = up.indices == rows
+    ptr = np.r_[0, np.cumsum(np.bincount(rows[on], minlength=layout.n_nodes))]
+    diag = bsr_matrix((up.data[on], up.indices[on], ptr), shape=up.shape).tocsr()
+    up = up.tocsr()
+    assert relative_difference(up + up.T - diag, expected) <= 1e-12
 
 
 def test_on_a_dask_cluster_the_streamed_tangent_is_the_local_one(model):

@@ -121,15 +121,17 @@ def check_surface_cloud(cloud, n_neighbors: int, allow_creases: bool = False) ->
 
 def build_surface_model(cloud, atlas_settings, make_embedder, make_lme, make_pu, *,
                         order: int, ghost_layers: int = 2, block: int = 1,
-                        log=None, keep_basis: bool = True) -> SurfaceModel:
+                        log=None, keep_basis: bool = True, solve: bool = True
+                        ) -> SurfaceModel:
     """Boundary, ghosts, atlas and quadrature (basis to chart derivative ``order``).
 
     Refuses before any work a model that cannot fit in memory: the atlas with its basis
     plus the tangent of ``block`` DOFs per node and its solve
     (:func:`pointatlas_atlas.memory_estimate.estimate_tangent_bytes`). Without
-    ``keep_basis`` the atlas keeps only its charts and Gauss points (``quadrature`` is None)
-    and the estimate counts the tangent's parts and sum, not its solve: the model of
-    :func:`.streamed_tangent.streamed_tangent`, which rebuilds the basis group by group."""
+    ``keep_basis`` the atlas keeps only its charts and Gauss points (``quadrature`` is None):
+    the model of :func:`.streamed_tangent.streamed_tangent`, which rebuilds the basis group
+    by group. Without ``solve`` (an assembly only) the estimate counts the tangent's parts
+    and their sum instead of the tangent and its factorisation."""
     import time
 
     from pointatlas_atlas.atlas import Atlas
@@ -164,10 +166,10 @@ def build_surface_model(cloud, atlas_settings, make_embedder, make_lme, make_pu,
     s = atlas_settings
     tangent = estimate_tangent_bytes(nodes.shape[0], block,
                                      support_size(2, s.gamma_lme, s.tol_lme),
-                                     # streamed: the parts (node pairs of several groups
-                                     # counted in each: 1.48 K on the 2·10⁴ hemisphere),
-                                     # summed into K in their place (streamed_tangent)
-                                     **({} if keep_basis else {"copies": 1.5}))
+                                     # no solve: the streamed parts (node pairs of several
+                                     # groups counted in each: 1.48 K on the 2·10⁴
+                                     # hemisphere), summed into K in their place
+                                     **({} if solve else {"copies": 1.5}))
     atlas.partition(nodes, markers, keep_basis=keep_basis, extra_bytes=tangent,  # AtlasError:
                     extra_what=f"a tangent of {block} DOF per node")     # charts fail
     warning = atlas.refinement_warning()  # only with atlas.allow_failed_patches=true

@@ -54,7 +54,8 @@ def build_model(cloud, settings, atlas_settings, make_embedder, make_lme, make_p
                              poisson_ratio=settings.poisson_ratio, thickness=settings.thickness)
     material.check()
     m = build_surface_model(cloud, atlas_settings, make_embedder, make_lme, make_pu, order=2,
-                            ghost_layers=settings.ghost_layers, block=3, log=log)
+                            ghost_layers=settings.ghost_layers, block=3, log=log,
+                            keep_basis=not settings.streamed_assembly)
     return ShellModel(m.points, m.nodes, m.boundary, m.curves, m.spacing, m.atlas,
                       m.quadrature, m.times, material=material)
 
@@ -64,12 +65,10 @@ def solve_linear(model: ShellModel, settings, log=None) -> ShellModel:
     from pointatlas_atlas.evaluation import basis_at_nodes
     from pointatlas_solvers.augmented_lagrangian import solve_augmented
 
-    from .linear import linear_stiffness
-
     t = model.times
     N_all = model.nodes.shape[0]
     with _timed(t, "assembly"):
-        K = regularize_ghosts(linear_stiffness(model.quadrature, model.material), model)
+        K = regularize_ghosts(stiffness(model), model)
     with _timed(t, "loads"):
         F = assemble_loads(model, settings, log)
     with _timed(t, "constraints"):
@@ -87,6 +86,30 @@ def solve_linear(model: ShellModel, settings, log=None) -> ShellModel:
     model.stiffness, model.forces, model.constraints = K, F, cons
     model.nodal_displacement, model.displacement, model.solve_info = U, u, info
     return model
+
+
+def stiffness(model: ShellModel):
+    """K at U = 0 (CSR): from the model's quadrature, or, on a model built without the basis
+    (``physics.streamed_assembly``), chart group by chart group on the run's executor
+    (:func:`pointatlas_kit.streamed_tangent.streamed_tangent`), refusing samples no Gauss
+    point integrates."""
+    from .linear import linear_stiffness
+
+    if model.quadrature is not None:
+        return linear_stiffness(model.quadrature, model.material)
+    from pointatlas_kit.fields import FieldLayout
+    from pointatlas_kit.streamed_tangent import streamed_tangent
+    from pointatlas_kit.surface_model import check_every_point_integrated
+
+    from .shell_energy import DISPLACEMENT, ShellEnergy
+
+    mat, n = model.material, model.nodes.shape[0]
+    K = streamed_tangent(model.atlas, FieldLayout([DISPLACEMENT], n),
+                         [ShellEnergy(mat.young_modulus, mat.poisson_ratio, mat.thickness)])
+    touched = np.zeros(n, bool)
+    touched[np.flatnonzero(np.diff(K.indptr))] = True
+    check_every_point_integrated(touched, np.arange(n) < model.points.shape[0])
+    return K.tocsr()
 
 
 def assemble_loads(model: ShellModel, settings, log=None) -> np.ndarray:

@@ -72,6 +72,12 @@ def build_path(physics, ctx, cloud, atlas_settings) -> ShellPath:
     from .analysis import assemble_loads, assemble_supports, build_model
 
     s = physics.shell_settings()
+    if s.streamed_assembly:
+        from pointatlas.errors import ConfigError
+
+        raise ConfigError("physics.streamed_assembly=true is for the linear analysis (one "
+                          "assembly); a load path assembles K at every Newton step from the "
+                          "kept basis: remove physics.streamed_assembly.")
     model = build_model(cloud, s, atlas_settings, **physics.factories(ctx, atlas_settings),
                         log=ctx.log)
     F = assemble_loads(model, s, ctx.log)

@@ -30,7 +30,7 @@ def field_dataset(model):
         "n_points": ((), model.points.shape[0], {**one, "long_name": "sampled points"}),
         "n_ghosts": ((), model.n_ghosts, {**one, "long_name": "ghost nodes beyond the boundary"}),
         "n_patches": ((), len(model.atlas.charts_), {**one, "long_name": "patches (charts)"}),
-        "n_quadrature_points": ((), len(model.quadrature.weights), {
+        "n_quadrature_points": ((), sum(len(c.weights) for c in model.atlas.quadrature_), {
             **one, "long_name": "quadrature points over all charts"}),
         "n_constraints": ((), model.constraints.matrix.shape[0], {
             **one, "long_name": "constraint rows of the supports"}),

@@ -42,6 +42,11 @@ def test_valid_settings_pass():
      r"^physics\.loads\[0\]\.force=\[0, nan, 1\] is invalid"),
     (dict(loads=[Load(kind="pressure")]), "needs pressure"),
     (dict(loads=[Load(kind="line", force=[0, 0, 1])]), "needs where"),
+    (dict(streamed_assembly=True, loads=[Load(kind="pressure", pressure=1.0)]),
+     r"^physics\.loads\[0\] \(pressure\) needs the basis at the Gauss points, which "
+     r"physics\.streamed_assembly=true does not keep: remove streamed_assembly or use point "
+     r"and line loads\.$"),
+    (dict(streamed_assembly="yes"), r"^physics\.streamed_assembly='yes' is invalid"),
     (dict(solver="magic"), r"^physics\.solver='magic' is invalid: it must be one of 'direct', "
                            r"'cg_ilu', 'superlu', 'pardiso', 'cg_amg', 'auto'\. Pass e\.g\. "
                            r"physics\.solver=auto\.$"),

@@ -248,16 +248,18 @@ def values_at(atlas, U_nodes: np.ndarray, x) -> tuple[np.ndarray, np.ndarray]:
 
 
 def ghost_springs(diagonal: np.ndarray, model: SurfaceModel, block: int,
-                  eps: float = 1e-10) -> np.ndarray:
+                  eps: float = 1e-10, seen: np.ndarray | None = None) -> np.ndarray:
     """(block·n_nodes,) spring stiffness per DOF: ε·mean(diag K) on ghost DOFs and
-    mean(diag K) on DOFs no quadrature point sees. A ghost far out carries basis functions
-    that are ~0 on the sampled surface (cut off by the LME tolerance), so its DOFs are nearly
-    free: the spring pins them without changing the field on the surface noticeably."""
+    mean(diag K) on DOFs no quadrature point sees (``seen`` (n_nodes,) bool, by default from
+    the model's quadrature). A ghost far out carries basis functions that are ~0 on the
+    sampled surface (cut off by the LME tolerance), so its DOFs are nearly free: the spring
+    pins them without changing the field on the surface noticeably."""
     n = model.nodes.shape[0]
     scale = float(np.mean(diagonal))
     node_w = np.zeros(n)
     node_w[model.points.shape[0]:] = eps
-    seen = np.zeros(n, bool)
-    seen[model.quadrature.indices] = True
-    node_w[~seen] = 1.0
+    if seen is None:
+        seen = np.zeros(n, bool)
+        seen[model.quadrature.indices] = True
+    node_w[~np.asarray(seen, bool)] = 1.0
     return np.repeat(node_w * scale, block)

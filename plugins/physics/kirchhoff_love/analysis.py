@@ -68,7 +68,7 @@ def solve_linear(model: ShellModel, settings, log=None) -> ShellModel:
     t = model.times
     N_all = model.nodes.shape[0]
     with _timed(t, "assembly"):
-        K = regularize_ghosts(stiffness(model), model)
+        K = regularize_ghosts(*stiffness(model), model)
     with _timed(t, "loads"):
         F = assemble_loads(model, settings, log)
     with _timed(t, "constraints"):
@@ -89,14 +89,15 @@ def solve_linear(model: ShellModel, settings, log=None) -> ShellModel:
 
 
 def stiffness(model: ShellModel):
-    """K at U = 0 (CSR): from the model's quadrature, or, on a model built without the basis
+    """(K at U = 0 (CSR), the nodes a Gauss point's basis touches or None): from the
+    model's quadrature, or, on a model built without the basis
     (``physics.streamed_assembly``), chart group by chart group on the run's executor
     (:func:`pointatlas_kit.streamed_tangent.streamed_tangent`), refusing samples no Gauss
     point integrates."""
     from .linear import linear_stiffness
 
     if model.quadrature is not None:
-        return linear_stiffness(model.quadrature, model.material)
+        return linear_stiffness(model.quadrature, model.material), None
     from pointatlas_kit.fields import FieldLayout
     from pointatlas_kit.streamed_tangent import streamed_tangent
     from pointatlas_kit.surface_model import check_every_point_integrated
@@ -109,7 +110,7 @@ def stiffness(model: ShellModel):
     touched = np.zeros(n, bool)
     touched[np.flatnonzero(np.diff(K.indptr))] = True
     check_every_point_integrated(touched, np.arange(n) < model.points.shape[0])
-    return K.tocsr()
+    return K.tocsr(), touched
 
 
 def assemble_loads(model: ShellModel, settings, log=None) -> np.ndarray:
@@ -149,14 +150,15 @@ def assemble_supports(model: ShellModel, settings):
     return cons
 
 
-def regularize_ghosts(K, model: ShellModel, eps: float = 1e-10):
-    """K plus the weak ghost springs (:func:`pointatlas_kit.surface_model.ghost_springs`)
-    on its diagonal."""
+def regularize_ghosts(K, seen, model: ShellModel, eps: float = 1e-10):
+    """K plus the weak ghost springs (:func:`pointatlas_kit.surface_model.ghost_springs`,
+    ``seen`` the nodes the quadrature touches, None: the model's quadrature) on its
+    diagonal."""
     from scipy.sparse import diags
 
     from pointatlas_kit.surface_model import ghost_springs
 
-    return (K + diags(ghost_springs(K.diagonal(), model, 3, eps))).tocsr()
+    return (K + diags(ghost_springs(K.diagonal(), model, 3, eps, seen))).tocsr()
 
 
 def pressure_normals(model: ShellModel) -> np.ndarray:

@@ -150,7 +150,7 @@ class Atlas:
 
     def partition(self, points: np.ndarray, markers: Optional[np.ndarray] = None, *,
                   keep_basis: bool = False, extra_bytes: int = 0,
-                  extra_what: str = "") -> np.ndarray:
+                  extra_what: str = "", extra_fix: str = "") -> np.ndarray:
         """Partition the markers (default: the points) and fit the PU. Returns labels (M,).
 
         First refuses (InputError) an atlas whose estimated memory does not fit the memory
@@ -167,7 +167,7 @@ class Atlas:
         self.chart_dim_ = int(getattr(self.make_embedder(), "n_components", 2))
         # refuse, before any work, an atlas that cannot fit in memory (one line, with fix)
         mem.check_atlas_memory(self, P.shape[0], Q.shape[0], P.shape[1], keep_basis,
-                               extra_bytes, extra_what)
+                               extra_bytes, extra_what, extra_fix)
         self.points_, self.markers_ = P, Q
         self.point_tree_ = cKDTree(P)
         self._control_sets, self._embeddings, self._margin_csr = {}, {}, None

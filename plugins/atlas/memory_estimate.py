@@ -188,9 +188,11 @@ def _cgroup_free() -> int | None:
 
 
 def check_atlas_memory(atlas, n_points: int, n_markers: int, ambient_dim: int,
-                       keep_basis: bool, extra_bytes: int = 0, extra_what: str = "") -> None:
+                       keep_basis: bool, extra_bytes: int = 0, extra_what: str = "",
+                       extra_fix: str = "") -> None:
     """Refuse, before any work, an atlas (with ``extra_bytes`` of what is computed on it,
-    e.g. a physics' tangent) that cannot fit in memory (one line, with fix)."""
+    e.g. a physics' tangent) that cannot fit in memory (one line, with fix; ``extra_fix``
+    one more way out the caller offers)."""
     needed = atlas.estimated_bytes(n_points, n_markers, ambient_dim, atlas.chart_dim_,
                                    keep_basis) + int(extra_bytes)
     available, _ = available_memory_bytes()
@@ -201,4 +203,5 @@ def check_atlas_memory(atlas, n_points: int, n_markers: int, ambient_dim: int,
                 f"{atlas.chart_dim_}, quadrature order {atlas.settings.quadrature_order})"
                 + (f" with {extra_what}" if extra_what else ""),
         f"Use fewer points (e.g. source.n_points={fitting}, memory grows in proportion), a "
-        "lower study.quadrature_order, or a machine with more memory.")
+        "lower study.quadrature_order, " + (f"{extra_fix}, " if extra_fix else "")
+        + "or a machine with more memory.")

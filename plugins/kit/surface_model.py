@@ -121,8 +121,8 @@ def check_surface_cloud(cloud, n_neighbors: int, allow_creases: bool = False) ->
 
 def build_surface_model(cloud, atlas_settings, make_embedder, make_lme, make_pu, *,
                         order: int, ghost_layers: int = 2, block: int = 1,
-                        log=None, keep_basis: bool = True, solve: bool = True
-                        ) -> SurfaceModel:
+                        log=None, keep_basis: bool = True, solve: bool = True,
+                        memory_fix: str = "") -> SurfaceModel:
     """Boundary, ghosts, atlas and quadrature (basis to chart derivative ``order``).
 
     Refuses before any work a model that cannot fit in memory: the atlas with its basis
@@ -131,7 +131,8 @@ def build_surface_model(cloud, atlas_settings, make_embedder, make_lme, make_pu,
     ``keep_basis`` the atlas keeps only its charts and Gauss points (``quadrature`` is None):
     the model of :func:`.streamed_tangent.streamed_tangent`, which rebuilds the basis group
     by group. Without ``solve`` (an assembly only) the estimate counts the tangent's parts
-    and their sum instead of the tangent and its factorisation."""
+    and their sum instead of the tangent and its factorisation. ``memory_fix``: one more way
+    out the refusal names (e.g. the physics' streamed assembly)."""
     import time
 
     from pointatlas_atlas.atlas import Atlas
@@ -171,7 +172,8 @@ def build_surface_model(cloud, atlas_settings, make_embedder, make_lme, make_pu,
                                      # hemisphere), summed into K in their place
                                      **({} if solve else {"copies": 1.5}))
     atlas.partition(nodes, markers, keep_basis=keep_basis, extra_bytes=tangent,  # AtlasError:
-                    extra_what=f"a tangent of {block} DOF per node")     # charts fail
+                    extra_what=f"a tangent of {block} DOF per node",     # charts fail
+                    extra_fix=memory_fix)
     warning = atlas.refinement_warning()  # only with atlas.allow_failed_patches=true
     if warning and log is not None:
         log.warning(warning)

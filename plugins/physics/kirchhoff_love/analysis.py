@@ -43,9 +43,11 @@ def _timed(times: dict, key: str):
 
 
 def build_model(cloud, settings, atlas_settings, make_embedder, make_lme, make_pu,
-                log=None) -> ShellModel:
+                log=None, linear: bool = True) -> ShellModel:
     """Boundary, ghosts, atlas and quadrature of a shell point cloud (no physics yet), by
-    the kit (:func:`pointatlas_kit.surface_model.build_surface_model`, order-2 basis)."""
+    the kit (:func:`pointatlas_kit.surface_model.build_surface_model`, order-2 basis);
+    ``linear``: for the linear analysis (a model too large for memory is then told about
+    ``physics.streamed_assembly``)."""
     from pointatlas_kit.surface_model import build_surface_model
 
     from .material import ShellMaterial
@@ -55,7 +57,10 @@ def build_model(cloud, settings, atlas_settings, make_embedder, make_lme, make_p
     material.check()
     m = build_surface_model(cloud, atlas_settings, make_embedder, make_lme, make_pu, order=2,
                             ghost_layers=settings.ghost_layers, block=3, log=log,
-                            keep_basis=not settings.streamed_assembly)
+                            keep_basis=not settings.streamed_assembly,
+                            memory_fix="" if settings.streamed_assembly or not linear else
+                            "physics.streamed_assembly=true (a linear analysis that does not "
+                            "keep the basis, most of this memory)")
     return ShellModel(m.points, m.nodes, m.boundary, m.curves, m.spacing, m.atlas,
                       m.quadrature, m.times, material=material)
 

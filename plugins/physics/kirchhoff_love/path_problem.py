@@ -79,7 +79,7 @@ def build_path(physics, ctx, cloud, atlas_settings) -> ShellPath:
                           "assembly); a load path assembles K at every Newton step from the "
                           "kept basis: remove physics.streamed_assembly.")
     model = build_model(cloud, s, atlas_settings, **physics.factories(ctx, atlas_settings),
-                        log=ctx.log)
+                        log=ctx.log, linear=False)
     F = assemble_loads(model, s, ctx.log)
     cons = assemble_supports(model, s)
     return ShellPath(model, s, F, cons)

@@ -28,3 +28,36 @@ def test_a_load_path_refuses_streamed_assembly_in_one_line(run_cli, tmp_path):
     assert ("physics.streamed_assembly=true is for the linear analysis (one assembly); a load "
             "path assembles K at every Newton step") in r.stderr + r.stdout
     assert "Traceback" not in r.stderr
+
+
+def test_a_linear_model_too_large_for_memory_names_streamed_assembly(monkeypatch):
+    """The refusal before any work offers physics.streamed_assembly to the linear analysis,
+    not to a load path (which refuses it)."""
+    import pytest
+
+    import pointatlas_atlas.memory_estimate as mem
+    from pointatlas.errors import InputError
+    from pointatlas_atlas.settings import AtlasSettings
+    from pointatlas_kit.selectors import Selector
+    from pointatlas_physics.kirchhoff_love.analysis import build_model
+    from pointatlas_physics.kirchhoff_love.settings import Load, ShellSettings, Support
+
+    monkeypatch.setattr(mem, "available_memory_bytes", lambda: (10 * 2**20, "a test limit"))
+    cloud = pointatlas.load_plugin("sources", "square_plate")(
+        n_points=196, model="quarter", length=10.0).load(np.random.default_rng(0))
+    s = ShellSettings(supports=[Support(kind="clamped", where=Selector(plane=[1, 0, 0, 5.0]))],
+                      loads=[Load(kind="point", at=[0, 0, 0], force=[0, 0, -1])])
+    factories = dict(
+        make_embedder=lambda: pointatlas.load_plugin("embedders", "pca")(n_components=2),
+        make_lme=lambda: pointatlas.load_plugin("approximants", "lme")(gamma=0.8, tol=1e-8,
+                                                                      outside="flag"),
+        make_pu=lambda: pointatlas.load_plugin("approximants", "shepard")(gamma=4.0, tol=1e-6,
+                                                                         outside="flag"))
+    for linear in (True, False):
+        with pytest.raises(InputError) as info:
+            build_model(cloud, s, AtlasSettings(), linear=linear, **factories)
+        msg = str(info.value)
+        assert "10.00 MiB is available (a test limit)" in msg and "\n" not in msg
+        offered = "physics.streamed_assembly=true (a linear analysis that does not keep the " \
+                  "basis, most of this memory), or a machine with more memory." in msg
+        assert offered == linear, msg

@@ -40,8 +40,12 @@ GROUP_POINTS = 40_000
 
 
 def morton_order(centres: np.ndarray) -> np.ndarray:
-    """Indices sorting points (n, D ≤ 3) along a Z-order (Morton) curve of 21 bits per axis."""
+    """Indices sorting points (n, D) along a Z-order (Morton) curve of 21 bits per axis (63
+    bits: points in D > 3 are ordered by their first three principal components)."""
     c = np.asarray(centres, dtype=np.float64)
+    if c.shape[1] > 3:
+        c = c - c.mean(axis=0)
+        c = c @ np.linalg.svd(c, full_matrices=False)[2][:3].T
     lo, span = c.min(axis=0), np.ptp(c, axis=0)
     grid = ((c - lo) / np.where(span > 0, span, 1.0) * (2 ** 21 - 1)).astype(np.uint64)
     code = np.zeros(len(c), np.uint64)
@@ -96,10 +100,10 @@ def tangent_of_charts(shared: dict, item: tuple):
     lengths = np.diff(plan.row_ptr)
     cols = plan.cols
     if shared["upper"]:
-        keep = cols >= np.repeat(np.arange(len(lengths)), lengths)
+        row_of = np.repeat(np.arange(len(lengths)), lengths)
+        keep = cols >= row_of
         cols, blocks = cols[keep], blocks[keep]
-        lengths = np.bincount(np.repeat(np.arange(len(lengths)), lengths)[keep],
-                              minlength=len(lengths))
+        lengths = np.bincount(row_of[keep], minlength=len(lengths))
     rows = np.flatnonzero(lengths)
     del asm, q
     # a tangent call leaves ~6 500 objects in reference cycles, some holding the group's

@@ -125,6 +125,13 @@ def test_morton_order_keeps_neighbours_close():
     for k in (1, 2, 3):
         runs = g[o].reshape(-1, 4**k, 2)
         assert (np.ptp(runs, axis=1) == 2**k - 1).all()
+    # the same grid placed in R^7 by an orthonormal map: ordered in its principal plane
+    # (turned within it), 21 bits per axis (no shift beyond the 64-bit code): consecutive
+    # points stay close (1.9 apart on average; a random order: 8.6)
+    Q = np.linalg.qr(np.random.default_rng(2).normal(size=(7, 2)))[0]
+    o7 = morton_order(g @ Q.T)
+    assert sorted(o7) == list(range(len(g)))
+    assert np.linalg.norm(np.diff(g[o7], axis=0), axis=1).mean() < 2.5
 
 
 def test_an_atlas_without_quadrature_is_refused_in_one_line():

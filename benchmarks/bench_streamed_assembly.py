@@ -50,7 +50,8 @@ def build_and_assemble(n: int, group_points: int) -> dict:
     from pointatlas_atlas.atlas import AtlasSettings
     from pointatlas_kit import streamed_tangent as st
     from pointatlas_kit.fields import FieldLayout
-    from pointatlas_kit.surface_model import build_surface_model, check_every_point_integrated
+    from pointatlas_kit.surface_model import (atlas_factories, build_surface_model,
+                                              check_every_point_integrated)
     from pointatlas_physics.kirchhoff_love.shell_energy import DISPLACEMENT, ShellEnergy
 
     times = {}
@@ -68,15 +69,9 @@ def build_and_assemble(n: int, group_points: int) -> dict:
         n_points=n, model="quarter", hole_angle_deg=0.0)
     cloud = source.load(np.random.default_rng(0))
     s = AtlasSettings()
-    factories = dict(
-        make_embedder=lambda: pointatlas.load_plugin("embedders", "pca")(n_components=2),
-        make_lme=lambda: pointatlas.load_plugin("approximants", "lme")(
-            gamma=s.gamma_lme, tol=s.tol_lme, outside="flag"),
-        make_pu=lambda: pointatlas.load_plugin("approximants", "shepard")(
-            gamma=s.gamma_pu, tol=s.tol_pu, outside="flag"))
     t0 = time.perf_counter()
     m = build_surface_model(cloud, s, order=2, block=3, keep_basis=False, solve=False,
-                            **factories)
+                            **atlas_factories(None, s))
     times["model_wall"] = time.perf_counter() - t0
     times.update({f"model_{k}": v for k, v in m.times.items()})
     layout = FieldLayout([DISPLACEMENT], m.nodes.shape[0])

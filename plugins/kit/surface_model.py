@@ -43,9 +43,11 @@ class SurfaceModel:
         return self.nodes.shape[0] - self.points.shape[0]
 
 
-def atlas_factories(ctx, atlas_settings, physics: str | None = None, **chart_options) -> dict:
+def atlas_factories(ctx, atlas_settings, physics: str | None = None, embedder: str = "pca",
+                    **chart_options) -> dict:
     """make_embedder / make_lme / make_pu of the run's ``embedder=`` and ``approximant=``
-    choices (through the registry; ``approximant`` unset means ``lme``), with the chart
+    choices (through the registry; ``approximant`` unset means ``lme``; without a run,
+    ``ctx`` None as in scripts and tests: the plugin ``embedder`` in 2-D), with the chart
     approximant's γ and tolerance from the atlas settings (``atlas.gamma_lme``,
     ``atlas.tol_lme``) and its other settings from the ``approximant`` group.
 
@@ -83,12 +85,20 @@ def atlas_factories(ctx, atlas_settings, physics: str | None = None, **chart_opt
                     f"settings hold it. Write atlas.{atlas_key}={chosen[key]!r} instead.")
         chosen = {k: v for k, v in chosen.items() if k not in ("gamma", "tol", "outside")}
     options = {**chosen, **chart_options}
+    if ctx is None:
+        from pointatlas.registry import load_plugin
+
+        def make(family, plugin, **kw):
+            return load_plugin(family, plugin)(**kw)
+    else:
+        make = ctx.make
     return dict(
-        make_embedder=lambda: ctx.plugin("embedder"),
-        make_lme=lambda: ctx.make("approximants", name, gamma=a.gamma_lme, tol=a.tol_lme,
-                                  outside="flag", **options),
-        make_pu=lambda: ctx.make("approximants", "shepard", gamma=a.gamma_pu, tol=a.tol_pu,
-                                 outside="flag"))
+        make_embedder=(lambda: ctx.plugin("embedder")) if ctx is not None else
+        (lambda: make("embedders", embedder, n_components=2)),
+        make_lme=lambda: make("approximants", name, gamma=a.gamma_lme, tol=a.tol_lme,
+                              outside="flag", **options),
+        make_pu=lambda: make("approximants", "shepard", gamma=a.gamma_pu, tol=a.tol_pu,
+                             outside="flag"))
 
 
 def check_surface_cloud(cloud, n_neighbors: int, allow_creases: bool = False) -> str | None:

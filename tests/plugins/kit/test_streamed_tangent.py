@@ -7,7 +7,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.sparse import bsr_matrix
 
-import pointatlas
 from pointatlas.errors import InputError
 from pointatlas.executor import using_executor
 from pointatlas.pointcloud import PointCloud
@@ -16,7 +15,7 @@ from pointatlas_kit.assembler import Assembler
 from pointatlas_kit.fields import FieldLayout
 from pointatlas_kit.streamed_tangent import (chart_groups, morton_order, streamed_tangent,
                                              sum_block_parts)
-from pointatlas_kit.surface_model import build_surface_model
+from pointatlas_kit.surface_model import atlas_factories, build_surface_model
 from pointatlas_physics.kirchhoff_love.shell_energy import DISPLACEMENT, ShellEnergy
 
 
@@ -33,14 +32,8 @@ def ellipsoid(n: int) -> np.ndarray:
 @pytest.fixture(scope="module")
 def model():
     s = AtlasSettings(markers_per_patch=100)
-    factories = dict(
-        make_embedder=lambda: pointatlas.load_plugin("embedders", "pca")(n_components=2),
-        make_lme=lambda: pointatlas.load_plugin("approximants", "lme")(
-            gamma=s.gamma_lme, tol=s.tol_lme, outside="flag"),
-        make_pu=lambda: pointatlas.load_plugin("approximants", "shepard")(
-            gamma=s.gamma_pu, tol=s.tol_pu, outside="flag"))
     m = build_surface_model(PointCloud(points=ellipsoid(1200), name="ellipsoid"), s,
-                            order=2, block=3, **factories)
+                            order=2, block=3, **atlas_factories(None, s))
     layout = FieldLayout([DISPLACEMENT], m.quadrature.n_nodes)
     return m, layout, [ShellEnergy(2.0e5, 0.3, 0.02)]
 

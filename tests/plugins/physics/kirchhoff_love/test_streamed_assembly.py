@@ -39,6 +39,7 @@ def test_a_linear_model_too_large_for_memory_names_streamed_assembly(monkeypatch
     from pointatlas.errors import InputError
     from pointatlas_atlas.settings import AtlasSettings
     from pointatlas_kit.selectors import Selector
+    from pointatlas_kit.surface_model import atlas_factories
     from pointatlas_physics.kirchhoff_love.analysis import build_model
     from pointatlas_physics.kirchhoff_love.settings import Load, ShellSettings, Support
 
@@ -47,15 +48,10 @@ def test_a_linear_model_too_large_for_memory_names_streamed_assembly(monkeypatch
         n_points=196, model="quarter", length=10.0).load(np.random.default_rng(0))
     s = ShellSettings(supports=[Support(kind="clamped", where=Selector(plane=[1, 0, 0, 5.0]))],
                       loads=[Load(kind="point", at=[0, 0, 0], force=[0, 0, -1])])
-    factories = dict(
-        make_embedder=lambda: pointatlas.load_plugin("embedders", "pca")(n_components=2),
-        make_lme=lambda: pointatlas.load_plugin("approximants", "lme")(gamma=0.8, tol=1e-8,
-                                                                      outside="flag"),
-        make_pu=lambda: pointatlas.load_plugin("approximants", "shepard")(gamma=4.0, tol=1e-6,
-                                                                         outside="flag"))
+    atlas = AtlasSettings()
     for linear in (True, False):
         with pytest.raises(InputError) as info:
-            build_model(cloud, s, AtlasSettings(), linear=linear, **factories)
+            build_model(cloud, s, atlas, linear=linear, **atlas_factories(None, atlas))
         msg = str(info.value)
         assert "10.00 MiB is available (a test limit)" in msg and "\n" not in msg
         offered = "physics.streamed_assembly=true (a linear analysis that does not keep the " \
